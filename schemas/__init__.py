@@ -1,0 +1,1 @@
+"""Message schemas, wire codec and key expressions: the contract between services."""

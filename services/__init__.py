@@ -1,0 +1,1 @@
+"""The navigation services and the transport they share."""

@@ -1,0 +1,1 @@
+"""Laser driver: turns a device's raw frames into validated laser scans."""

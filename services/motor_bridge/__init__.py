@@ -1,0 +1,1 @@
+"""Motor bridge: velocity commands to base commands, within limits, stopping on stale input."""

@@ -1,0 +1,216 @@
+"""What every service process shares: typed inputs and outputs, health counters,
+liveliness, and a clean stop.
+
+A service declares its inputs with :meth:`Node.subscribe` (a topic and a handler) and
+its outputs with :meth:`Node.publisher`, then awaits :meth:`Node.spin`. Each input runs
+in its own asyncio task on one loop, so handlers never run concurrently. A payload that
+does not decode is counted and logged (once per key and kind, then at most every
+``LOG_EVERY`` seconds) and the service carries on; so does a handler that raises.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import inspect
+import logging
+import time
+from collections import Counter
+from collections.abc import Awaitable, Callable, Coroutine
+from typing import Any, Generic, TypeVar
+
+from zenav.schemas.codec import DecodeError, decode, encode
+from zenav.schemas.keys import Keys, Topic
+from zenav.schemas.messages import Message, ServiceStatus
+from zenav.services.transport import Bus, Publisher, Subscription, Token
+
+log = logging.getLogger(__name__)
+
+M = TypeVar("M", bound=Message)
+Handler = Callable[[M], Awaitable[None] | None]
+
+LOG_EVERY = 10.0
+"""Seconds between two log lines about the same kind of rejected input."""
+
+STATUS_PERIOD = 1.0
+"""Seconds between two status messages (wall clock: this is health, not control)."""
+
+
+class TypedPublisher(Generic[M]):
+    """Publishes one topic's messages and numbers them."""
+
+    def __init__(self, publisher: Publisher, topic: Topic) -> None:
+        self._publisher = publisher
+        self.topic = topic
+        self._seq = 0
+        self.last: M | None = None
+
+    def next_seq(self) -> int:
+        seq = self._seq
+        self._seq += 1
+        return seq
+
+    def publish(self, message: M) -> None:
+        if not isinstance(message, self.topic.message):
+            raise TypeError(f"{self.topic.name} carries {self.topic.message.__name__}")
+        self._publisher.put(encode(message))
+        self.last = message
+
+    def republish(self) -> None:
+        """Send the last message again (answers a retransmitted input)."""
+        if self.last is not None:
+            self._publisher.put(encode(self.last))
+
+
+class _RateLimitedLog:
+    def __init__(self, service: str) -> None:
+        self._service = service
+        self._last: dict[tuple[str, str], float] = {}
+        self._since: Counter[tuple[str, str]] = Counter()
+
+    def __call__(self, key: str, kind: str, text: str) -> None:
+        now = time.monotonic()
+        mark = (key, kind)
+        self._since[mark] += 1
+        last = self._last.get(mark)
+        if last is None or now - last >= LOG_EVERY:
+            count = self._since.pop(mark)
+            extra = f" ({count} of this kind since the last report)" if last is not None else ""
+            log.warning("%s rejected input: %s%s", self._service, text, extra)
+            self._last[mark] = now
+
+
+class Node:
+    """One service's connection to the bus."""
+
+    def __init__(self, name: str, bus: Bus, keys: Keys) -> None:
+        self.name = name
+        self.bus = bus
+        self.keys = keys
+        self.received: Counter[str] = Counter()
+        self.rejected: Counter[str] = Counter()
+        self.handler_errors = 0
+        self._inputs: list[tuple[Subscription, Topic, Callable[[Any], Any]]] = []
+        self._tasks: list[asyncio.Task[None]] = []
+        self._stop = asyncio.Event()
+        self._token: Token | None = None
+        self._log_rejection = _RateLimitedLog(name)
+        self._status = TypedPublisher[ServiceStatus](
+            bus.publisher(keys.status(name)), Topic(f"status/{name}", ServiceStatus)
+        )
+
+    # -- declarations ------------------------------------------------------------------
+
+    def publisher(
+        self, topic: Topic, message_type: type[M], *, reliable: bool = False, urgent: bool = False
+    ) -> TypedPublisher[M]:
+        if topic.message is not message_type:
+            raise TypeError(f"{topic.name} carries {topic.message.__name__}")
+        return TypedPublisher[M](
+            self.bus.publisher(self.keys.of(topic), reliable=reliable, urgent=urgent), topic
+        )
+
+    def subscribe(
+        self, topic: Topic, message_type: type[M], handler: Handler[M], *, depth: int = 1
+    ) -> Subscription:
+        """Call ``handler`` with each valid message on ``topic``; keep at most ``depth``
+        waiting (newest wins)."""
+        if topic.message is not message_type:
+            raise TypeError(f"{topic.name} carries {topic.message.__name__}")
+        sub = self.bus.subscribe(self.keys.of(topic), depth)
+        self._inputs.append((sub, topic, handler))
+        return sub
+
+    def add_task(self, coro: Coroutine[Any, Any, None], name: str) -> None:
+        """Run ``coro`` alongside the inputs; it is cancelled at stop."""
+        self._tasks.append(asyncio.get_running_loop().create_task(coro, name=name))
+
+    # -- running -----------------------------------------------------------------------
+
+    @property
+    def stopping(self) -> bool:
+        return self._stop.is_set()
+
+    def request_stop(self) -> None:
+        self._stop.set()
+
+    async def spin(self) -> None:
+        """Serve every input until :meth:`request_stop`; then undeclare and return."""
+        loop = asyncio.get_running_loop()
+        self._token = self.bus.declare_token(self.keys.alive(self.name))
+        for sub, topic, handler in self._inputs:
+            self._tasks.append(
+                loop.create_task(self._serve(sub, topic, handler), name=f"input:{topic.name}")
+            )
+        self._tasks.append(loop.create_task(self._report_status(), name="status"))
+        try:
+            await self._stop.wait()
+        finally:
+            for task in self._tasks:
+                task.cancel()
+            await asyncio.gather(*self._tasks, return_exceptions=True)
+            self._tasks.clear()
+            for sub, _, _ in self._inputs:
+                sub.close()
+            if self._token is not None:
+                self._token.undeclare()
+                self._token = None
+
+    async def _serve(self, sub: Subscription, topic: Topic, handler: Callable[[Any], Any]) -> None:
+        while True:
+            key, payload = await sub.get()
+            try:
+                message = decode(payload, topic.message, key, topic.max_bytes)
+            except DecodeError as exc:
+                self.reject(key, exc.kind, str(exc))
+                continue
+            self.received[topic.name] += 1
+            try:
+                result = handler(message)
+                if inspect.isawaitable(result):
+                    await result
+            except asyncio.CancelledError:
+                raise
+            except Exception:
+                self.handler_errors += 1
+                log.exception("%s: handler for %s failed; input dropped", self.name, key)
+
+    def reject(self, key: str, kind: str, text: str) -> None:
+        """Count an input refused for ``kind`` and log it, rate-limited per key and kind."""
+        self.rejected[kind] += 1
+        self._log_rejection(key, kind, text)
+
+    def status(self, stamp: float = 0.0) -> ServiceStatus:
+        return ServiceStatus(
+            stamp=stamp,
+            seq=self._status.next_seq(),
+            service=self.name,
+            received=dict(self.received),
+            rejected=dict(self.rejected),
+            dropped={sub.key_expr: sub.dropped for sub, _, _ in self._inputs if sub.dropped},
+            handler_errors=self.handler_errors,
+        )
+
+    async def _report_status(self) -> None:
+        while True:
+            await asyncio.sleep(STATUS_PERIOD)
+            self._status.publish(self.status(stamp=time.time()))
+
+
+class StampGate:
+    """Orders one input stream by stamp.
+
+    ``check(stamp)`` answers ``"new"`` for a stamp later than any seen, ``"repeat"`` for
+    the latest one again (a retransmission: answer it by republishing the last output),
+    and ``"old"`` for anything earlier (out of order: drop it).
+    """
+
+    def __init__(self) -> None:
+        self.last: float | None = None
+
+    def check(self, stamp: float) -> str:
+        if self.last is None or stamp > self.last:
+            self.last = stamp
+            return "new"
+        if stamp == self.last:
+            return "repeat"
+        return "old"

@@ -1,0 +1,1 @@
+"""Planner: collision prediction, the paper's responses and simplified Morphin."""

@@ -1,0 +1,32 @@
+"""Drive toward a point: the robot's motion between decisions (pure, no I/O)."""
+
+from __future__ import annotations
+
+import math
+
+from zenav.sim.kinematics import wrap_angle
+
+
+def command_toward(
+    x: float,
+    y: float,
+    heading: float,
+    target: tuple[float, float],
+    speed: float,
+    heading_gain: float,
+    max_omega: float,
+) -> tuple[float, float]:
+    """(v, omega) that heads for ``target`` at up to ``speed`` m/s.
+
+    The turn rate is proportional to the heading error; the forward speed falls with
+    the cosine of the error, so the robot turns on the spot when the target is behind it
+    and does not overshoot a target closer than one second of travel.
+    """
+    dx, dy = target[0] - x, target[1] - y
+    distance = math.hypot(dx, dy)
+    if distance < 1e-9:
+        return 0.0, 0.0
+    error = wrap_angle(math.atan2(dy, dx) - heading)
+    omega = max(-max_omega, min(max_omega, heading_gain * error))
+    v = min(speed, distance) * max(0.0, math.cos(error))
+    return v, omega

@@ -1,0 +1,160 @@
+"""Start one service as its own process: ``zenav service NAME`` or ``python -m ...``.
+
+Each service module defines ``Params`` (a pydantic model with every default) and
+``Service``, built as ``Service(node, params)``. A service with work of its own (the
+simulator's clock, the motor bridge's watchdog) has ``async def run()``; when ``run``
+returns, the process stops. SIGINT and SIGTERM stop it cleanly: inputs cancelled,
+liveliness token and declarations undeclared, session closed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import importlib
+import logging
+import signal
+import sys
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from zenav.schemas.keys import Keys, check_robot_id
+from zenav.services.config import (
+    DEFAULT_BASE_PORT,
+    SERVICE_ORDER,
+    ConfigError,
+    load_params,
+    loopback_mesh,
+    read_yaml,
+)
+from zenav.services.node import Node
+from zenav.services.transport import Bus, TransportConfig, ZenohBus
+
+log = logging.getLogger(__name__)
+
+SERVICE_MODULES: dict[str, str] = {
+    "simulator": "zenav.sim.node",
+    "laser_driver": "zenav.services.laser_driver.node",
+    "perception": "zenav.services.perception.node",
+    "tracking": "zenav.services.tracking.node",
+    "planner": "zenav.services.planner.node",
+    "motor_bridge": "zenav.services.motor_bridge.node",
+}
+assert tuple(SERVICE_MODULES) == SERVICE_ORDER
+
+
+def service_module(name: str) -> ModuleType:
+    if name not in SERVICE_MODULES:
+        raise ConfigError(f"no service named {name!r}; the services are {', '.join(SERVICE_ORDER)}")
+    return importlib.import_module(SERVICE_MODULES[name])
+
+
+def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options every process that joins the bus shares (services and tools)."""
+    group = parser.add_argument_group("transport")
+    group.add_argument("--robot-id", default="robot0", help="robot id in every key (default robot0)")
+    group.add_argument("--transport", type=Path, help="YAML file of transport settings")
+    group.add_argument("--mode", choices=["peer", "client", "router"], help="Zenoh mode")
+    group.add_argument("--listen", action="append", default=[], metavar="ENDPOINT")
+    group.add_argument("--connect", action="append", default=[], metavar="ENDPOINT")
+    group.add_argument(
+        "--base-port",
+        type=int,
+        default=DEFAULT_BASE_PORT,
+        help="first port of the loopback mesh used when no endpoint is given",
+    )
+
+
+def transport_from_args(args: argparse.Namespace, service: str | None) -> TransportConfig:
+    if args.transport is not None:
+        try:
+            config = TransportConfig.model_validate(read_yaml(args.transport))
+        except ValueError as exc:
+            raise ConfigError(f"{args.transport}: {exc}") from None
+    elif args.listen or args.connect:
+        config = TransportConfig(listen=args.listen, connect=args.connect)
+    else:
+        config = loopback_mesh(service, args.base_port)
+    if args.mode is not None:
+        config = config.model_copy(update={"mode": args.mode})
+    return config
+
+
+def setup_logging(level: str, name: str) -> None:
+    logging.basicConfig(
+        level=level.upper(),
+        stream=sys.stderr,
+        format=f"%(asctime)s {name} %(levelname)s %(message)s",
+    )
+
+
+async def serve(name: str, bus: Bus, keys: Keys, params: Any) -> None:
+    """Build the service on ``bus`` and run it until stopped or until its run() ends."""
+    module = service_module(name)
+    node = Node(name, bus, keys)
+    service = module.Service(node, params)
+    loop = asyncio.get_running_loop()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        try:
+            loop.add_signal_handler(signum, node.request_stop)
+        except (NotImplementedError, RuntimeError):  # not the main thread
+            pass
+    run = getattr(service, "run", None)
+    failure: list[BaseException] = []
+    if run is not None:
+
+        async def run_then_stop() -> None:
+            try:
+                await run()
+            except asyncio.CancelledError:
+                raise
+            except Exception as exc:
+                failure.append(exc)
+            finally:
+                node.request_stop()
+
+        node.add_task(run_then_stop(), name="run")
+    await node.spin()
+    close = getattr(service, "close", None)
+    if close is not None:
+        close()
+    if failure:
+        raise failure[0]
+
+
+def main(name: str, argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog=f"zenav service {name}")
+    parser.add_argument("--config", type=Path, action="append", default=[], metavar="FILE",
+                        help="YAML parameter file (repeatable; later files win)")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override one parameter (dotted names for nested ones)")
+    parser.add_argument("--log-level", default="INFO")
+    add_transport_arguments(parser)
+    args = parser.parse_args(argv)
+    setup_logging(args.log_level, name)
+    try:
+        module = service_module(name)
+        params = load_params(module.Params, args.config, args.set)
+        keys = Keys(check_robot_id(args.robot_id))
+        transport = transport_from_args(args, name)
+    except (ConfigError, ValueError) as exc:
+        print(f"zenav {name}: {exc}", file=sys.stderr)
+        return 2
+
+    async def amain() -> None:
+        bus = ZenohBus(transport, asyncio.get_running_loop())
+        try:
+            await serve(name, bus, keys, params)
+        finally:
+            bus.close()
+
+    try:
+        asyncio.run(amain())
+    except KeyboardInterrupt:
+        pass
+    except Exception as exc:
+        log.debug("service %s failed", name, exc_info=True)
+        log.error("service %s failed: %s: %s", name, type(exc).__name__, exc)
+        return 1
+    return 0

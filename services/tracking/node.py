@@ -1,0 +1,56 @@
+"""Tracking service: obstacle chains in, tracks (type, speed, heading) out."""
+
+from __future__ import annotations
+
+import math
+
+from zenav.schemas import keys
+from zenav.schemas.messages import ObstacleChain, Track, TrackList
+from zenav.services.node import Node, StampGate
+from zenav.services.perception.wire import from_message
+from zenav.services.tracking.params import TrackingParams
+from zenav.services.tracking.tracker import Track as TrackState
+from zenav.services.tracking.tracker import Tracker
+
+Params = TrackingParams
+
+
+def track_message(track: TrackState) -> Track:
+    return Track(
+        id=track.id, kind=track.kind, x=track.x, y=track.y, vx=track.vx, vy=track.vy,
+        speed=track.speed, heading=track.heading, radius=track.radius,
+        xi=min(max(track.xi, 0.0), 1.0), varsigma=min(max(track.varsigma, 0.0), 1.0),
+        alpha_o_deg=track.alpha_o_deg % 360.0 if math.isfinite(track.alpha_o_deg) else 0.0,
+        age=track.age, cells=track.box, area=track.area, visible=track.visible,
+    )
+
+
+class Service:
+    def __init__(self, node: Node, params: TrackingParams) -> None:
+        self.node = node
+        self.tracker = Tracker(params)
+        self.tracks = node.publisher(keys.TRACKS, TrackList)
+        self.gate = StampGate()
+        node.subscribe(keys.OBSTACLES, ObstacleChain, self.on_chain, depth=2)
+
+    def on_chain(self, chain: ObstacleChain) -> None:
+        order = self.gate.check(chain.stamp)
+        if order == "repeat":
+            self.tracks.republish()
+            return
+        if order == "old":
+            self.node.reject(self.node.keys.of(keys.OBSTACLES), "out_of_order",
+                             f"chain stamped {chain.stamp} after {self.gate.last}")
+            return
+        clusters = from_message(chain)
+        states = self.tracker.update(chain.stamp, clusters.pose, clusters)
+        self.tracks.publish(
+            TrackList(stamp=chain.stamp, seq=self.tracks.next_seq(), pose=chain.pose,
+                      tracks=[track_message(t) for t in states])
+        )
+
+
+if __name__ == "__main__":
+    from zenav.services.runner import main
+
+    raise SystemExit(main("tracking"))

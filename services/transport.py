@@ -1,0 +1,303 @@
+"""The message bus: one interface, a Zenoh implementation and an in-memory one.
+
+Services see bytes in and bytes out; encoding lives in :mod:`zenav.schemas.codec`.
+
+Zenoh delivers samples on its own threads and has no asyncio API. The Zenoh callback
+here does one thing: hand the payload to the asyncio loop with
+``call_soon_threadsafe``. Everything else (decode, validate, compute) happens in the
+service's asyncio task, so nothing ever blocks a Zenoh thread. Each subscription keeps
+a bounded newest-wins buffer: when a consumer falls behind, the oldest sample is
+dropped and counted, and no queue grows without bound.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+from abc import ABC, abstractmethod
+from collections import deque
+from collections.abc import Callable
+from typing import Any, Literal
+
+import zenoh
+from pydantic import BaseModel, ConfigDict, Field
+
+log = logging.getLogger(__name__)
+
+LivelinessCallback = Callable[[str, bool], None]
+"""Called on the asyncio loop with (token key, alive)."""
+
+
+class TransportConfig(BaseModel):
+    """How a process joins the Zenoh network.
+
+    The embedded default is a peer listening on its own loopback port and connecting
+    to the other services' ports, with multicast scouting off: nothing to install or
+    start, and two stacks on different ports never meet.
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    mode: Literal["peer", "client", "router"] = "peer"
+    listen: list[str] = Field(default_factory=list, description="endpoints, e.g. tcp/127.0.0.1:7450")
+    connect: list[str] = Field(default_factory=list, description="endpoints to connect to")
+    multicast_scouting: bool = False
+    lease_ms: int = Field(1000, ge=100, description="link lease: how soon a dead peer is noticed")
+    extra: dict[str, Any] = Field(
+        default_factory=dict, description="further Zenoh settings, path -> JSON value"
+    )
+
+    def to_zenoh(self) -> zenoh.Config:
+        conf = zenoh.Config()
+        conf.insert_json5("mode", json.dumps(self.mode))
+        conf.insert_json5("scouting/multicast/enabled", json.dumps(self.multicast_scouting))
+        conf.insert_json5("listen/endpoints", json.dumps(self.listen))
+        conf.insert_json5("connect/endpoints", json.dumps(self.connect))
+        conf.insert_json5("transport/link/tx/lease", json.dumps(self.lease_ms))
+        for path, value in self.extra.items():
+            conf.insert_json5(path, json.dumps(value))
+        return conf
+
+
+class Subscription:
+    """Samples of one key expression, buffered newest-wins for an asyncio consumer.
+
+    ``push`` must be called on the loop's thread; ``get`` awaits the next sample.
+    """
+
+    def __init__(self, key_expr: str, depth: int) -> None:
+        if depth < 1:
+            raise ValueError("a subscription needs a depth of at least 1")
+        self.key_expr = key_expr
+        self.depth = depth
+        self.dropped = 0
+        self._buffer: deque[tuple[str, bytes]] = deque()
+        self._ready = asyncio.Event()
+        self._closed = False
+        self.on_close: Callable[[], None] | None = None
+
+    def push(self, key: str, payload: bytes) -> None:
+        if self._closed:
+            return
+        if len(self._buffer) >= self.depth:
+            self._buffer.popleft()
+            self.dropped += 1
+        self._buffer.append((key, payload))
+        self._ready.set()
+
+    async def get(self) -> tuple[str, bytes]:
+        """The oldest buffered (key, payload); waits when there is none."""
+        while not self._buffer:
+            if self._closed:
+                raise asyncio.CancelledError("subscription closed")
+            self._ready.clear()
+            await self._ready.wait()
+        return self._buffer.popleft()
+
+    def pending(self) -> int:
+        return len(self._buffer)
+
+    def close(self) -> None:
+        self._closed = True
+        self._ready.set()
+        if self.on_close is not None:
+            self.on_close()
+            self.on_close = None
+
+
+class Publisher(ABC):
+    @abstractmethod
+    def put(self, payload: bytes) -> None: ...
+
+
+class Token(ABC):
+    @abstractmethod
+    def undeclare(self) -> None: ...
+
+
+class Bus(ABC):
+    """What a service needs from the middleware."""
+
+    @abstractmethod
+    def publisher(self, key: str, *, reliable: bool = False, urgent: bool = False) -> Publisher:
+        """A publisher on ``key``. ``reliable`` blocks instead of dropping under congestion;
+        ``urgent`` raises the priority (velocity and base commands)."""
+
+    @abstractmethod
+    def subscribe(self, key_expr: str, depth: int = 1) -> Subscription: ...
+
+    @abstractmethod
+    def declare_token(self, key: str) -> Token:
+        """Announce this process's liveliness on ``key`` until undeclared."""
+
+    @abstractmethod
+    def watch_liveliness(self, key_expr: str, callback: LivelinessCallback) -> None:
+        """Call ``callback`` for tokens already alive and every later appearance or loss."""
+
+    @abstractmethod
+    def close(self) -> None: ...
+
+
+# --- in memory ------------------------------------------------------------------------
+
+
+def key_matches(key_expr: str, key: str) -> bool:
+    """Zenoh's own key-expression intersection, for the in-memory bus."""
+    return bool(zenoh.KeyExpr(key_expr).intersects(zenoh.KeyExpr(key)))
+
+
+class _MemoryPublisher(Publisher):
+    def __init__(self, bus: InMemoryBus, key: str) -> None:
+        self._bus = bus
+        self._key = key
+
+    def put(self, payload: bytes) -> None:
+        self._bus.deliver(self._key, bytes(payload))
+
+
+class _MemoryToken(Token):
+    def __init__(self, bus: InMemoryBus, key: str) -> None:
+        self._bus = bus
+        self.key = key
+
+    def undeclare(self) -> None:
+        self._bus.set_alive(self.key, False)
+
+
+class InMemoryBus(Bus):
+    """A bus inside one process and one asyncio loop, for service tests.
+
+    Several services can share one instance; ``published`` keeps every put for
+    assertions.
+    """
+
+    def __init__(self) -> None:
+        self._subs: list[Subscription] = []
+        self._alive: set[str] = set()
+        self._watchers: list[tuple[str, LivelinessCallback]] = []
+        self.published: list[tuple[str, bytes]] = []
+
+    def deliver(self, key: str, payload: bytes) -> None:
+        self.published.append((key, payload))
+        for sub in list(self._subs):
+            if key_matches(sub.key_expr, key):
+                sub.push(key, payload)
+
+    def publisher(self, key: str, *, reliable: bool = False, urgent: bool = False) -> Publisher:
+        return _MemoryPublisher(self, key)
+
+    def subscribe(self, key_expr: str, depth: int = 1) -> Subscription:
+        sub = Subscription(key_expr, depth)
+        self._subs.append(sub)
+        sub.on_close = lambda: self._subs.remove(sub)
+        return sub
+
+    def declare_token(self, key: str) -> Token:
+        self.set_alive(key, True)
+        return _MemoryToken(self, key)
+
+    def set_alive(self, key: str, alive: bool) -> None:
+        if alive:
+            self._alive.add(key)
+        else:
+            self._alive.discard(key)
+        for pattern, callback in self._watchers:
+            if key_matches(pattern, key):
+                callback(key, alive)
+
+    def watch_liveliness(self, key_expr: str, callback: LivelinessCallback) -> None:
+        self._watchers.append((key_expr, callback))
+        for key in sorted(self._alive):
+            if key_matches(key_expr, key):
+                callback(key, True)
+
+    def close(self) -> None:
+        for sub in list(self._subs):
+            sub.close()
+
+
+# --- Zenoh ---------------------------------------------------------------------------
+
+
+class _ZenohPublisher(Publisher):
+    def __init__(self, publisher: Any) -> None:
+        self._publisher = publisher
+
+    def put(self, payload: bytes) -> None:
+        self._publisher.put(payload)
+
+
+class _ZenohToken(Token):
+    def __init__(self, token: Any) -> None:
+        self._token = token
+
+    def undeclare(self) -> None:
+        self._token.undeclare()
+
+
+class ZenohBus(Bus):
+    """The bus over one Zenoh session, bridged to one asyncio loop."""
+
+    def __init__(self, config: TransportConfig, loop: asyncio.AbstractEventLoop) -> None:
+        self._loop = loop
+        self._session = zenoh.open(config.to_zenoh())
+        self._declared: list[Any] = []
+
+    @property
+    def session(self) -> Any:
+        return self._session
+
+    def _to_loop(self, callback: Callable[..., None], *args: object) -> None:
+        """Runs on a Zenoh thread: schedule ``callback`` on the loop and return at once."""
+        try:
+            self._loop.call_soon_threadsafe(callback, *args)
+        except RuntimeError:  # the loop is closed: the process is shutting down
+            pass
+
+    def publisher(self, key: str, *, reliable: bool = False, urgent: bool = False) -> Publisher:
+        pub = self._session.declare_publisher(
+            key,
+            congestion_control=(
+                zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP
+            ),
+            priority=zenoh.Priority.REAL_TIME if urgent else zenoh.Priority.DATA,
+            express=True,
+        )
+        self._declared.append(pub)
+        return _ZenohPublisher(pub)
+
+    def subscribe(self, key_expr: str, depth: int = 1) -> Subscription:
+        sub = Subscription(key_expr, depth)
+
+        def on_sample(sample: Any) -> None:
+            try:
+                self._to_loop(sub.push, str(sample.key_expr), sample.payload.to_bytes())
+            except Exception:  # never let an exception reach Zenoh's thread
+                log.exception("zenoh callback failed on %s", key_expr)
+
+        handle = self._session.declare_subscriber(key_expr, on_sample)
+        self._declared.append(handle)
+        return sub
+
+    def declare_token(self, key: str) -> Token:
+        token = self._session.liveliness().declare_token(key)
+        self._declared.append(token)
+        return _ZenohToken(token)
+
+    def watch_liveliness(self, key_expr: str, callback: LivelinessCallback) -> None:
+        def on_sample(sample: Any) -> None:
+            alive = sample.kind == zenoh.SampleKind.PUT
+            self._to_loop(callback, str(sample.key_expr), alive)
+
+        handle = self._session.liveliness().declare_subscriber(key_expr, on_sample, history=True)
+        self._declared.append(handle)
+
+    def close(self) -> None:
+        for handle in reversed(self._declared):
+            try:
+                handle.undeclare()
+            except Exception:  # already undeclared or session gone
+                log.debug("undeclare failed", exc_info=True)
+        self._declared.clear()
+        self._session.close()

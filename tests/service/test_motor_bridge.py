@@ -1,0 +1,102 @@
+"""The motor bridge on the in-memory bus: limits, stale-command stop, bad input."""
+
+from __future__ import annotations
+
+import asyncio
+
+import pytest
+
+from zenav.schemas import keys
+from zenav.schemas.messages import BaseCommand, Odometry, Pose2D, VelocityCommand
+from zenav.services.motor_bridge.node import Params
+from tests.service.harness import running
+
+
+def odom(t: float) -> Odometry:
+    return Odometry(stamp=t, seq=0, pose=Pose2D(x=0.0, y=0.0, heading=0.0), v=0.0, omega=0.0)
+
+
+def cmd(t: float, v: float, omega: float = 0.0) -> VelocityCommand:
+    return VelocityCommand(stamp=t, seq=0, v=v, omega=omega)
+
+
+async def test_commands_are_clamped_to_speed_and_acceleration_limits():
+    params = Params(max_speed=0.2, accel=0.5, decel=1.0, max_omega=1.0, angular_accel=100.0)
+    async with running("motor_bridge", params) as h:
+        h.send(keys.CMD_VEL, cmd(0.0, 5.0, omega=3.0))
+        await h.settle()
+        h.send(keys.CMD_VEL, cmd(0.1, 5.0, omega=3.0))
+        await h.settle()
+        h.send(keys.CMD_VEL, cmd(1.0, 5.0, omega=-3.0))
+        await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+    assert [round(c.v, 6) for c in out] == [0.05, 0.1, 0.2]  # 0.5 m/s^2 x 0.1 s steps, cap
+    assert [c.omega for c in out] == [1.0, 1.0, -1.0]
+    assert all(c.reason == "command" for c in out)
+
+
+async def test_stale_commands_stop_the_robot_on_the_stamp_clock():
+    params = Params(stale_timeout=0.5, accel=10.0)
+    async with running("motor_bridge", params) as h:
+        h.send(keys.CMD_VEL, cmd(1.0, 0.1))
+        for t in (1.1, 1.3, 1.5):
+            h.send(keys.ODOM, odom(t))
+        await h.settle()
+        assert [c.reason for c in h.received(keys.BASE_CMD, BaseCommand)] == ["command"]
+        h.send(keys.ODOM, odom(1.6))  # 0.6 s after the last command
+        h.send(keys.ODOM, odom(1.7))
+        await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+        assert [c.reason for c in out] == ["command", "stale"]  # one stop, not one per tick
+        assert out[-1].v == 0.0 and out[-1].omega == 0.0 and out[-1].stamp == 1.6
+        h.send(keys.CMD_VEL, cmd(1.8, 0.1))  # commands resume
+        await h.settle()
+        assert h.received(keys.BASE_CMD, BaseCommand)[-1].reason == "command"
+
+
+async def test_no_stop_before_the_first_command():
+    async with running("motor_bridge", Params(stale_timeout=0.5)) as h:
+        for t in (0.0, 1.0, 2.0):
+            h.send(keys.ODOM, odom(t))
+        await h.settle()
+        assert h.received(keys.BASE_CMD, BaseCommand) == []
+
+
+async def test_wall_clock_watchdog_stops_the_robot_in_realtime_mode():
+    params = Params(clock="realtime", stale_timeout=0.1, watchdog_period=0.02, accel=10.0)
+    async with running("motor_bridge", params) as h:
+        h.send(keys.CMD_VEL, cmd(5.0, 0.1))
+        await asyncio.sleep(0.3)  # no odometry either: only the wall clock notices
+        out = h.received(keys.BASE_CMD, BaseCommand)
+    assert [c.reason for c in out] == ["command", "stale"]
+    assert out[-1].v == 0.0
+
+
+async def test_repeated_command_is_answered_again_and_old_one_dropped():
+    async with running("motor_bridge", Params(accel=10.0)) as h:
+        for message in (cmd(2.0, 0.1), cmd(2.0, 0.1), cmd(1.0, 0.2)):
+            h.send(keys.CMD_VEL, message)
+            await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+        assert len(out) == 2 and out[0] == out[1]
+        assert h.node.rejected["out_of_order"] == 1
+
+
+@pytest.mark.parametrize("payload", [b"", b"\xff\xfe", b"\x93\x01\x02\x03"])
+async def test_bad_payloads_are_counted_and_the_bridge_keeps_working(payload):
+    async with running("motor_bridge", Params(accel=10.0)) as h:
+        h.send_raw(keys.CMD_VEL, payload)
+        h.send(keys.CMD_VEL, cmd(0.5, 0.1))
+        await h.settle()
+        assert sum(h.node.rejected.values()) == 1
+        assert len(h.received(keys.BASE_CMD, BaseCommand)) == 1
+
+
+async def test_a_burst_keeps_only_the_newest_commands_and_counts_the_drop():
+    async with running("motor_bridge", Params(accel=10.0)) as h:
+        for t in (1.0, 2.0, 3.0, 4.0):  # faster than the bridge reads: depth is 2
+            h.send(keys.CMD_VEL, cmd(t, 0.1))
+        await h.settle()
+        stamps = [c.stamp for c in h.received(keys.BASE_CMD, BaseCommand)]
+        assert stamps == [3.0, 4.0]
+        assert h.node.status().dropped == {"zenav/test/cmd_vel": 2}

@@ -1,0 +1,83 @@
+"""The ``zenav`` command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from zenav.services.config import SERVICE_ORDER
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from zenav.run import RunFailed, run_scenario
+    from zenav.sim.scenario import ScenarioError
+
+    try:
+        record = run_scenario(args.scenario, args.out, planner=args.planner,
+                              log_level=args.log_level)
+    except ScenarioError as exc:
+        print(f"zenav run: {exc}", file=sys.stderr)
+        return 2
+    except RunFailed as exc:
+        print(f"zenav run: {exc}", file=sys.stderr)
+        return 1
+    clearance = record["min_clearance"]
+    print(f"{record['scenario']}: {record['outcome']} at t={record['time']:.2f} s, "
+          f"path {record['path_length']:.2f} m, min clearance "
+          f"{'-' if clearance is None else f'{clearance:.3f} m'}, "
+          f"{len(record['events'])} events, {record['wall_time']:.1f} s wall -> {args.out}")
+    return 0
+
+
+def _cmd_service(args: argparse.Namespace, rest: list[str]) -> int:
+    from zenav.services.runner import main as service_main
+
+    return service_main(args.name, rest)
+
+
+def _cmd_schemas(args: argparse.Namespace) -> int:
+    from zenav.schemas.messages import ALL_MESSAGES
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    for message in ALL_MESSAGES:
+        schema = message.model_json_schema(mode="serialization")
+        path = args.out / f"{message.TYPE}.schema.json"
+        path.write_text(json.dumps(schema, indent=2) + "\n")
+        print(path)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="zenav", description="Mobile-robot navigation as Zenoh services."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    run = sub.add_parser("run", help="run a scenario through the whole stack")
+    run.add_argument("scenario", type=Path, help="scenario YAML file")
+    run.add_argument("--out", type=Path, required=True, help="directory for run.json, run.png")
+    run.add_argument("--planner", default="paper", help="planner service (default paper)")
+    run.add_argument("--log-level", default="INFO", help="services' log level")
+
+    service = sub.add_parser("service", help="run one service process",
+                             description="Run one service; options after NAME go to it "
+                                         "(zenav service NAME --help).")
+    service.add_argument("name", choices=SERVICE_ORDER)
+
+    schemas = sub.add_parser("schemas", help="write the JSON Schema of every message")
+    schemas.add_argument("--out", type=Path, default=Path("schemas/json"))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser()
+    if argv[:1] == ["service"]:
+        args, rest = parser.parse_known_args(argv)
+        return _cmd_service(args, rest)
+    args = parser.parse_args(argv)
+    if args.command == "run":
+        return _cmd_run(args)
+    return _cmd_schemas(args)

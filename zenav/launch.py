@@ -1,0 +1,148 @@
+"""Start a whole service stack as separate processes and watch over it.
+
+Used by ``zenav run`` and by the integration tests. Each service is its own process
+(``python -m zenav service NAME``) with its parameters in a YAML file and its output in
+a log file of its own. A stack gets its own block of loopback ports, so two stacks on
+one machine never hear each other.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from zenav.services.config import SERVICE_ORDER, loopback_mesh
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+DEPLOY_PARAMS = REPO_ROOT / "deploy" / "params"
+
+
+def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) -> int:
+    """A base port such that base..base+count-1 are free on loopback.
+
+    Chosen below the usual ephemeral range (32768+) so outgoing connections do not take
+    them meanwhile.
+    """
+    rng = random.Random(os.getpid() ^ time.monotonic_ns())
+    for _ in range(attempts):
+        base = rng.randrange(20000, 32000 - count)
+        sockets = []
+        try:
+            for port in range(base, base + count):
+                s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+                sockets.append(s)
+                s.bind(("127.0.0.1", port))
+            return base
+        except OSError:
+            continue
+        finally:
+            for s in sockets:
+                s.close()
+    raise RuntimeError("no free block of loopback ports found")
+
+
+def _deep_merge(base: dict[str, Any], update: Mapping[str, Any]) -> dict[str, Any]:
+    merged = dict(base)
+    for key, value in update.items():
+        if isinstance(value, Mapping) and isinstance(merged.get(key), dict):
+            merged[key] = _deep_merge(merged[key], value)
+        else:
+            merged[key] = value
+    return merged
+
+
+def write_params(directory: Path, service: str, overrides: Mapping[str, Any]) -> Path:
+    """The service's deploy defaults (if any) merged with ``overrides``, as a YAML file."""
+    base: dict[str, Any] = {}
+    deploy_file = DEPLOY_PARAMS / f"{service}.yaml"
+    if deploy_file.exists():
+        base = yaml.safe_load(deploy_file.read_text()) or {}
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / f"{service}.yaml"
+    path.write_text(yaml.safe_dump(_deep_merge(base, overrides), sort_keys=False))
+    return path
+
+
+def last_line(path: Path) -> str:
+    try:
+        lines = [line for line in path.read_text(errors="replace").splitlines() if line.strip()]
+    except OSError:
+        return ""
+    return lines[-1].strip() if lines else ""
+
+
+@dataclass
+class Stack:
+    """The service processes of one robot."""
+
+    out_dir: Path
+    params: Mapping[str, Mapping[str, Any]]
+    robot_id: str = "robot0"
+    base_port: int = field(default_factory=free_port_block)
+    services: Iterable[str] = SERVICE_ORDER
+    log_level: str = "INFO"
+    processes: dict[str, subprocess.Popen[bytes]] = field(default_factory=dict)
+
+    def command(self, service: str) -> list[str]:
+        params_file = write_params(self.out_dir / "params", service, self.params.get(service, {}))
+        return [
+            sys.executable, "-m", "zenav", "service", service,
+            "--config", str(params_file),
+            "--robot-id", self.robot_id,
+            "--base-port", str(self.base_port),
+            "--log-level", self.log_level,
+        ]
+
+    def log_path(self, service: str) -> Path:
+        return self.out_dir / "logs" / f"{service}.log"
+
+    def start(self) -> None:
+        (self.out_dir / "logs").mkdir(parents=True, exist_ok=True)
+        for service in self.services:
+            self.start_service(service)
+
+    def start_service(self, service: str) -> None:
+        with self.log_path(service).open("ab") as log:
+            self.processes[service] = subprocess.Popen(
+                self.command(service), stdout=log, stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL,
+            )
+
+    def transport(self) -> Any:
+        """Transport settings for a tool process joining this stack."""
+        return loopback_mesh(None, self.base_port)
+
+    def failure(self) -> str | None:
+        """A one-line reason if a service has exited, else None."""
+        for service, proc in self.processes.items():
+            code = proc.poll()
+            if code is not None:
+                why = last_line(self.log_path(service))
+                return f"service {service} exited with status {code}" + (f": {why}" if why else "")
+        return None
+
+    def stop(self, grace: float = 3.0) -> dict[str, int]:
+        """SIGTERM every service, SIGKILL what is left after ``grace`` s; exit codes."""
+        for proc in self.processes.values():
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGTERM)
+        deadline = time.monotonic() + grace
+        codes = {}
+        for service, proc in self.processes.items():
+            try:
+                codes[service] = proc.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                codes[service] = proc.wait()
+        return codes

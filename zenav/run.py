@@ -1,0 +1,154 @@
+"""``zenav run SCENARIO --out DIR``: one scenario through the whole service stack.
+
+It starts the six service processes on their own loopback ports, joins them as a
+read-only tool, collects the planner's events and the simulator's result, stops every
+process and writes ``run.json`` and ``run.png``. A service that fails to start or dies
+ends the command with a one-line reason and a non-zero status, never a hang.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+from zenav.launch import Stack
+from zenav.schemas import keys
+from zenav.schemas.codec import DecodeError, decode
+from zenav.schemas.keys import Keys
+from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
+from zenav.services.transport import ZenohBus
+from zenav.sim.scenario import Scenario, load_scenario
+
+PLANNERS = ("paper",)
+"""Planner services ``--planner`` can pick."""
+
+
+class RunFailed(RuntimeError):
+    """The run could not be made; the message is the one-line reason."""
+
+
+def stack_params(scenario: Scenario, scenario_path: Path, planner: str) -> dict[str, dict[str, Any]]:
+    """Per-service parameters that follow from the scenario (robot, laser, world grid)."""
+    robot, laser, cell = scenario.robot, scenario.laser, scenario.world.cell
+    scan_period = 1.0 / laser.rate_hz
+    return {
+        "simulator": {"scenario": str(scenario_path.resolve()), "clock": "lockstep",
+                      "wait_for": ["laser_driver", "perception", "tracking", "planner",
+                                   "motor_bridge", "run"]},
+        "laser_driver": {"fov_deg": laser.fov_deg, "resolution_deg": laser.resolution_deg,
+                         "range_max": laser.max_range, "rate_hz": laser.rate_hz},
+        "perception": {"cell": cell, "window_radius": min(8 * cell, laser.max_range)},
+        "tracking": {},
+        "planner": {"goal": list(robot.goal), "start": list(robot.start),
+                    "goal_tolerance": robot.goal_tolerance, "cruise_speed": robot.speed,
+                    "max_speed": robot.effective_max_speed, "robot_radius": robot.radius},
+        "motor_bridge": {"max_speed": robot.effective_max_speed,
+                         "command_period": scan_period,
+                         "stale_timeout": max(0.5, 3 * scan_period)},
+    }
+
+
+def _finite_or_none(value: float) -> float | None:
+    return None if math.isinf(value) or math.isnan(value) else round(value, 6)
+
+
+def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> dict[str, Any]:
+    """The run record of the spec (``run.json``), from the simulator's result."""
+    trajectory = [[round(float(v), 6) for v in row] for row in result.trajectory]
+    return {
+        "scenario": result.scenario,
+        "planner": planner,
+        "outcome": result.outcome,
+        "time": round(result.time, 6),
+        "path_length": round(result.path_length, 6),
+        "min_clearance": _finite_or_none(result.min_clearance),
+        "collided_with": result.collided_with,
+        "trajectory": trajectory,
+        "events": [
+            {"t": round(e.stamp, 6), "obstacle": e.obstacle, "kind": e.kind,
+             "scenario": e.scenario, "action": e.action, "detail": e.detail}
+            for e in sorted(events, key=lambda e: (e.stamp, e.seq))
+            if e.stamp <= result.time + 1e-9
+        ],
+    }
+
+
+async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, list[PlannerEvent]]:
+    """Join the stack, gather events until the simulator's result arrives."""
+    k = Keys(stack.robot_id)
+    bus = ZenohBus(stack.transport(), asyncio.get_running_loop())
+    try:
+        token = bus.declare_token(k.alive("run"))
+        results = bus.subscribe(k.of(keys.RESULT), depth=1)
+        events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
+        odom = bus.subscribe(k.of(keys.ODOM), depth=1)
+        events: list[PlannerEvent] = []
+        last_progress = time.monotonic()
+        sim_time = -1.0
+        result: RunResult | None = None
+        while result is None:
+            failure = stack.failure()
+            if failure:
+                raise RunFailed(failure)
+            try:
+                _, payload = await asyncio.wait_for(results.get(), timeout=0.1)
+                result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
+            except TimeoutError:
+                pass
+            while odom.pending():
+                _, payload = await odom.get()
+                stamp = decode(payload, Odometry, k.of(keys.ODOM)).stamp
+                if stamp > sim_time:
+                    sim_time, last_progress = stamp, time.monotonic()
+            if time.monotonic() - last_progress > progress_timeout:
+                where = "before the first tick" if sim_time < 0 else f"at t={sim_time:.2f} s"
+                raise RunFailed(f"the simulation made no progress for {progress_timeout:.0f} s "
+                                f"{where}; see the logs in {stack.out_dir / 'logs'}")
+        await asyncio.sleep(0.3)  # let the last events in flight arrive
+        while events_sub.pending():
+            _, payload = await events_sub.get()
+            try:
+                events.append(decode(payload, PlannerEvent, k.of(keys.EVENTS)))
+            except DecodeError:
+                continue
+        token.undeclare()
+        return result, events
+    finally:
+        bus.close()
+
+
+def run_scenario(
+    scenario_path: Path,
+    out_dir: Path,
+    planner: str = "paper",
+    progress_timeout: float = 90.0,
+    log_level: str = "INFO",
+) -> dict[str, Any]:
+    """Run one scenario through the full stack; write run.json and run.png; the record."""
+    scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
+    if planner not in PLANNERS:
+        raise RunFailed(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stack = Stack(out_dir=out_dir, params=stack_params(scenario, scenario_path, planner),
+                  log_level=log_level)
+    started = time.monotonic()
+    stack.start()
+    try:
+        result, events = asyncio.run(_collect(stack, progress_timeout))
+    finally:
+        codes = stack.stop()
+    record = make_record(result, events, planner)
+    record["wall_time"] = round(time.monotonic() - started, 3)
+    record["seed"] = scenario.seed
+    unclean = {name: code for name, code in codes.items() if code != 0}
+    if unclean:
+        record["unclean_exits"] = unclean
+    (out_dir / "run.json").write_text(json.dumps(record, indent=1))
+    from zenav.plot import plot_run  # matplotlib is slow to import; only here
+
+    plot_run(scenario, record, out_dir / "run.png")
+    return record
