@@ -175,7 +175,7 @@ class LaserScan(Message):
 
     def angles(self) -> npt.NDArray[np.float64]:
         """Beam angles relative to the heading, rad."""
-        return self.angle_min + self.angle_increment * np.arange(self.ranges.size)
+        return self.angle_min + self.angle_increment * np.arange(self.ranges.size, dtype=np.float64)
 
 
 class Odometry(Message):

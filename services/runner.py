@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import importlib
 import logging
 import signal
@@ -53,7 +54,8 @@ def service_module(name: str) -> ModuleType:
 def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
     """Options every process that joins the bus shares (services and tools)."""
     group = parser.add_argument_group("transport")
-    group.add_argument("--robot-id", default="robot0", help="robot id in every key (default robot0)")
+    group.add_argument("--robot-id", default="robot0",
+                       help="robot id in every key (default robot0)")
     group.add_argument("--transport", type=Path, help="YAML file of transport settings")
     group.add_argument("--mode", choices=["peer", "client", "router"], help="Zenoh mode")
     group.add_argument("--listen", action="append", default=[], metavar="ENDPOINT")
@@ -96,10 +98,8 @@ async def serve(name: str, bus: Bus, keys: Keys, params: Any) -> None:
     service = module.Service(node, params)
     loop = asyncio.get_running_loop()
     for signum in (signal.SIGINT, signal.SIGTERM):
-        try:
+        with contextlib.suppress(NotImplementedError, RuntimeError):  # not the main thread
             loop.add_signal_handler(signum, node.request_stop)
-        except (NotImplementedError, RuntimeError):  # not the main thread
-            pass
     run = getattr(service, "run", None)
     failure: list[BaseException] = []
     if run is not None:

@@ -13,6 +13,7 @@ dropped and counted, and no queue grows without bound.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import logging
 from abc import ABC, abstractmethod
@@ -40,7 +41,9 @@ class TransportConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     mode: Literal["peer", "client", "router"] = "peer"
-    listen: list[str] = Field(default_factory=list, description="endpoints, e.g. tcp/127.0.0.1:7450")
+    listen: list[str] = Field(
+        default_factory=list, description="endpoints, e.g. tcp/127.0.0.1:7450"
+    )
     connect: list[str] = Field(default_factory=list, description="endpoints to connect to")
     multicast_scouting: bool = False
     lease_ms: int = Field(1000, ge=100, description="link lease: how soon a dead peer is noticed")
@@ -241,7 +244,7 @@ class ZenohBus(Bus):
 
     def __init__(self, config: TransportConfig, loop: asyncio.AbstractEventLoop) -> None:
         self._loop = loop
-        self._session = zenoh.open(config.to_zenoh())
+        self._session: Any = zenoh.open(config.to_zenoh())
         self._declared: list[Any] = []
 
     @property
@@ -250,10 +253,8 @@ class ZenohBus(Bus):
 
     def _to_loop(self, callback: Callable[..., None], *args: object) -> None:
         """Runs on a Zenoh thread: schedule ``callback`` on the loop and return at once."""
-        try:
+        with contextlib.suppress(RuntimeError):  # a closed loop: the process is stopping
             self._loop.call_soon_threadsafe(callback, *args)
-        except RuntimeError:  # the loop is closed: the process is shutting down
-            pass
 
     def publisher(self, key: str, *, reliable: bool = False, urgent: bool = False) -> Publisher:
         pub = self._session.declare_publisher(

@@ -71,7 +71,7 @@ class Params(BaseModel):
     result_repeat: float = Field(0.5, gt=0, description="wall s between result repeats")
 
 
-class StackSilent(RuntimeError):
+class StackSilentError(RuntimeError):
     """The stack stopped answering in lockstep mode."""
 
 
@@ -252,8 +252,10 @@ class Service:
         while missing := set(self.params.wait_for) - self._alive:
             left = deadline - time.monotonic()
             if left <= 0:
-                raise StackSilent(f"services not up after {self.params.startup_timeout:.0f} s: "
-                                  f"{', '.join(sorted(missing))}")
+                raise StackSilentError(
+                    f"services not up after {self.params.startup_timeout:.0f} s: "
+                    f"{', '.join(sorted(missing))}"
+                )
             self._alive_changed.clear()
             try:
                 await asyncio.wait_for(self._alive_changed.wait(), timeout=left)
@@ -279,7 +281,7 @@ class Service:
             except TimeoutError:
                 waited += self.params.retransmit_after
                 if waited >= self.params.answer_timeout:
-                    raise StackSilent(
+                    raise StackSilentError(
                         f"no base command for t={self.sim.t:.2f} s within "
                         f"{self.params.answer_timeout:.0f} s"
                     ) from None

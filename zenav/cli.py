@@ -11,16 +11,17 @@ from zenav.services.config import SERVICE_ORDER
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from zenav.run import RunFailed, run_scenario
+    from zenav.run import RunError, run_scenario
+    from zenav.services.config import ConfigError
     from zenav.sim.scenario import ScenarioError
 
     try:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
-                              log_level=args.log_level)
-    except ScenarioError as exc:
+                              overrides=args.set, log_level=args.log_level)
+    except (ScenarioError, ConfigError) as exc:
         print(f"zenav run: {exc}", file=sys.stderr)
         return 2
-    except RunFailed as exc:
+    except RunError as exc:
         print(f"zenav run: {exc}", file=sys.stderr)
         return 1
     clearance = record["min_clearance"]
@@ -59,6 +60,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", type=Path, help="scenario YAML file")
     run.add_argument("--out", type=Path, required=True, help="directory for run.json, run.png")
     run.add_argument("--planner", default="paper", help="planner service (default paper)")
+    run.add_argument("--set", action="append", default=[], metavar="SERVICE.NAME=VALUE",
+                     help="override a service parameter, e.g. perception.lambda_=1.5")
     run.add_argument("--log-level", default="INFO", help="services' log level")
 
     service = sub.add_parser("service", help="run one service process",

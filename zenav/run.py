@@ -20,6 +20,7 @@ from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
+from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import Scenario, load_scenario
 
@@ -27,11 +28,13 @@ PLANNERS = ("paper",)
 """Planner services ``--planner`` can pick."""
 
 
-class RunFailed(RuntimeError):
+class RunError(RuntimeError):
     """The run could not be made; the message is the one-line reason."""
 
 
-def stack_params(scenario: Scenario, scenario_path: Path, planner: str) -> dict[str, dict[str, Any]]:
+def stack_params(
+    scenario: Scenario, scenario_path: Path, planner: str
+) -> dict[str, dict[str, Any]]:
     """Per-service parameters that follow from the scenario (robot, laser, world grid)."""
     robot, laser, cell = scenario.robot, scenario.laser, scenario.world.cell
     scan_period = 1.0 / laser.rate_hz
@@ -50,6 +53,18 @@ def stack_params(scenario: Scenario, scenario_path: Path, planner: str) -> dict[
                          "command_period": scan_period,
                          "stale_timeout": max(0.5, 3 * scan_period)},
     }
+
+
+def apply_override(params: dict[str, dict[str, Any]], text: str) -> None:
+    """Apply ``SERVICE.NAME=VALUE`` (NAME may be dotted) to the per-service parameters."""
+    path, value = parse_assignment(text)
+    if len(path) < 2 or path[0] not in SERVICE_ORDER:
+        raise ConfigError(f"--set {text!r}: expected SERVICE.NAME=VALUE with SERVICE one of "
+                          f"{', '.join(SERVICE_ORDER)}")
+    target = params.setdefault(path[0], {})
+    for part in path[1:-1]:
+        target = target.setdefault(part, {})
+    target[path[-1]] = value
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -93,7 +108,7 @@ async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, li
         while result is None:
             failure = stack.failure()
             if failure:
-                raise RunFailed(failure)
+                raise RunError(failure)
             try:
                 _, payload = await asyncio.wait_for(results.get(), timeout=0.1)
                 result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
@@ -106,7 +121,7 @@ async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, li
                     sim_time, last_progress = stamp, time.monotonic()
             if time.monotonic() - last_progress > progress_timeout:
                 where = "before the first tick" if sim_time < 0 else f"at t={sim_time:.2f} s"
-                raise RunFailed(f"the simulation made no progress for {progress_timeout:.0f} s "
+                raise RunError(f"the simulation made no progress for {progress_timeout:.0f} s "
                                 f"{where}; see the logs in {stack.out_dir / 'logs'}")
         await asyncio.sleep(0.3)  # let the last events in flight arrive
         while events_sub.pending():
@@ -125,16 +140,19 @@ def run_scenario(
     scenario_path: Path,
     out_dir: Path,
     planner: str = "paper",
+    overrides: list[str] | None = None,
     progress_timeout: float = 90.0,
     log_level: str = "INFO",
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
-        raise RunFailed(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
+        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
+    params = stack_params(scenario, scenario_path, planner)
+    for text in overrides or []:
+        apply_override(params, text)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stack = Stack(out_dir=out_dir, params=stack_params(scenario, scenario_path, planner),
-                  log_level=log_level)
+    stack = Stack(out_dir=out_dir, params=params, log_level=log_level)
     started = time.monotonic()
     stack.start()
     try:

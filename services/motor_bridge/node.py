@@ -130,7 +130,8 @@ class Service:
     async def run(self) -> None:
         """The wall-clock watchdog, in real-time mode only."""
         if self.params.clock != "realtime":
-            return await asyncio.Event().wait()  # nothing to do; stopped with the node
+            await asyncio.Event().wait()  # nothing to do; cancelled when the node stops
+            return
         while True:
             await asyncio.sleep(self.params.watchdog_period)
             silent = time.monotonic() - self.last_command_wall

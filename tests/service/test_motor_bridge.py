@@ -6,10 +6,10 @@ import asyncio
 
 import pytest
 
+from tests.service.harness import running
 from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, Odometry, Pose2D, VelocityCommand
 from zenav.services.motor_bridge.node import Params
-from tests.service.harness import running
 
 
 def odom(t: float) -> Odometry:

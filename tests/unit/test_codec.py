@@ -33,7 +33,7 @@ def scan(**overrides: object) -> LaserScan:
         ranges=np.linspace(0.5, 7.5, 361, dtype=np.float32),
     )
     fields.update(overrides)
-    return LaserScan(**fields)  # type: ignore[arg-type]
+    return LaserScan.model_validate(fields)
 
 
 def raw_scan_fields(**overrides: object) -> bytes:

@@ -1,0 +1,1 @@
+"""The simulator that stands in for the robot hardware."""
