@@ -24,9 +24,6 @@ import yaml
 
 from zenav.services.config import SERVICE_ORDER, loopback_mesh
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-DEPLOY_PARAMS = REPO_ROOT / "deploy" / "params"
-
 
 def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) -> int:
     """A base port such that base..base+count-1 are free on loopback.
@@ -52,25 +49,12 @@ def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) ->
     raise RuntimeError("no free block of loopback ports found")
 
 
-def _deep_merge(base: dict[str, Any], update: Mapping[str, Any]) -> dict[str, Any]:
-    merged = dict(base)
-    for key, value in update.items():
-        if isinstance(value, Mapping) and isinstance(merged.get(key), dict):
-            merged[key] = _deep_merge(merged[key], value)
-        else:
-            merged[key] = value
-    return merged
-
-
-def write_params(directory: Path, service: str, overrides: Mapping[str, Any]) -> Path:
-    """The service's deploy defaults (if any) merged with ``overrides``, as a YAML file."""
-    base: dict[str, Any] = {}
-    deploy_file = DEPLOY_PARAMS / f"{service}.yaml"
-    if deploy_file.exists():
-        base = yaml.safe_load(deploy_file.read_text()) or {}
+def write_params(directory: Path, service: str, params: Mapping[str, Any]) -> Path:
+    """A service's parameter overrides as the YAML file its process reads; kept with the
+    run's output so the run can be repeated service by service."""
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / f"{service}.yaml"
-    path.write_text(yaml.safe_dump(_deep_merge(base, overrides), sort_keys=False))
+    path.write_text(yaml.safe_dump(dict(params), sort_keys=False))
     return path
 
 
