@@ -210,6 +210,9 @@ class Obstacle(BaseModel):
     edges: tuple[int, int] = Field(
         description="what lies beyond each end: 0 free, 1 occluded, 2 clipped by the window"
     )
+    moved: float = Field(
+        0.0, ge=0.0, le=1.0, description="free-space motion score (0 = stood still)"
+    )
 
 
 class ObstacleChain(Message):

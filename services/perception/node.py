@@ -15,8 +15,9 @@ from collections import deque
 from zenav.schemas import keys
 from zenav.schemas.messages import LaserScan, ObstacleChain, Odometry
 from zenav.services.node import Node, StampGate
-from zenav.services.perception.clustering import Pose, cluster_scan
+from zenav.services.perception.clustering import Pose
 from zenav.services.perception.params import PerceptionParams
+from zenav.services.perception.perceive import Perceiver
 from zenav.services.perception.wire import to_message
 from zenav.sim.kinematics import wrap_angle
 
@@ -67,6 +68,7 @@ class Service:
         self.gate = StampGate()
         self.history = PoseHistory()
         self.waiting: LaserScan | None = None
+        self.perceiver = Perceiver(params)
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
         node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=16)
 
@@ -84,8 +86,11 @@ class Service:
             self.chains.republish()
             return
         if order == "old":
-            self.node.reject(self.node.keys.of(keys.SCAN), "out_of_order",
-                             f"scan stamped {scan.stamp} after {self.gate.last}")
+            self.node.reject(
+                self.node.keys.of(keys.SCAN),
+                "out_of_order",
+                f"scan stamped {scan.stamp} after {self.gate.last}",
+            )
             return
         pose = self.history.at(scan.stamp)
         if pose is not None:
@@ -93,12 +98,12 @@ class Service:
         elif self.history.newest is None or scan.stamp > self.history.newest:
             self.waiting = scan  # its odometry is still on the way
         else:
-            self.node.reject(self.node.keys.of(keys.SCAN), "no_pose",
-                             f"no odometry around t={scan.stamp}")
+            self.node.reject(
+                self.node.keys.of(keys.SCAN), "no_pose", f"no odometry around t={scan.stamp}"
+            )
 
     def process(self, scan: LaserScan, pose: Pose) -> None:
-        clusters = cluster_scan(scan.ranges, scan.angle_min, scan.angle_increment,
-                                scan.range_min, scan.range_max, pose, self.params)
+        clusters = self.perceiver.process(scan, pose)
         self.chains.publish(
             to_message(clusters, scan.stamp, self.chains.next_seq(), self.params.window_radius)
         )

@@ -23,8 +23,12 @@ def to_message(clusters: Clusters, stamp: float, seq: int, window_radius: float)
             y=float(clusters.centre[k, 1]),
             rho=float(clusters.mean_rho[k]),
             alpha=float(clusters.mean_alpha[k]),
-            cells=(int(clusters.box[k, 0]), int(clusters.box[k, 1]), int(clusters.box[k, 2]),
-                   int(clusters.box[k, 3])),
+            cells=(
+                int(clusters.box[k, 0]),
+                int(clusters.box[k, 1]),
+                int(clusters.box[k, 2]),
+                int(clusters.box[k, 3]),
+            ),
             area=int(clusters.area[k]),
             beams=(int(clusters.beams[k, 0]), int(clusters.beams[k, 1])),
             n_beams=int(clusters.n_beams[k]),
@@ -33,12 +37,17 @@ def to_message(clusters: Clusters, stamp: float, seq: int, window_radius: float)
             chord=_pair(clusters.chord_centre[k]),
             radius=float(clusters.radius[k]),
             edges=(int(clusters.edge_start[k]), int(clusters.edge_end[k])),
+            moved=float(clusters.moved[k]) if clusters.moved is not None else 0.0,
         )
         for k in range(len(clusters))
     ]
     return ObstacleChain(
-        stamp=stamp, seq=seq, pose=Pose2D(x=x, y=y, heading=heading),
-        window_radius=window_radius, cell=clusters.cell, obstacles=obstacles,
+        stamp=stamp,
+        seq=seq,
+        pose=Pose2D(x=x, y=y, heading=heading),
+        window_radius=window_radius,
+        cell=clusters.cell,
+        obstacles=obstacles,
     )
 
 
@@ -65,6 +74,7 @@ def from_message(chain: ObstacleChain) -> Clusters:
         radius=np.asarray([o.radius for o in obs], dtype=np.float64),
         edge_start=np.asarray([o.edges[0] for o in obs], dtype=np.int64),
         edge_end=np.asarray([o.edges[1] for o in obs], dtype=np.int64),
+        moved=np.asarray([o.moved for o in obs], dtype=np.float64),
         pose=pose,
         cell=chain.cell,
     )

@@ -1,22 +1,64 @@
-"""Planner service: reads tracks (which carry the robot pose at scan time) and
-publishes one velocity command per scan, toward the goal along the global path."""
+"""Planner service: tracks in (they carry the robot pose at scan time), one velocity
+command per scan out, plus an event for every decision that changes what the robot does
+and the planner's state for monitors."""
 
 from __future__ import annotations
 
-import math
-
 from zenav.schemas import keys
-from zenav.schemas.messages import PlannerState, TrackList, VelocityCommand
+from zenav.schemas.messages import PlannerEvent, PlannerState, TrackList, VelocityCommand
 from zenav.services.node import Node, StampGate
-from zenav.services.planner.follow import command_toward
+from zenav.services.planner.decide import Decision, Planner
 from zenav.services.planner.params import Params
+from zenav.services.planner.prediction import Obstacle
+
+
+def obstacles_of(tracks: TrackList) -> list[Obstacle]:
+    return [
+        Obstacle(id=t.id, kind=t.kind, position=(t.x, t.y),
+                 velocity=(t.vx, t.vy) if t.kind == "dynamic" else (0.0, 0.0),
+                 radius=t.radius, cells=t.cells)
+        for t in tracks.tracks
+    ]
+
+
+class EventLog:
+    """Decides which decisions are events: a change of scenario, action or obstacle, and
+    every crosser judged harmless ((c) or (d)) once."""
+
+    def __init__(self, horizon: float) -> None:
+        self.horizon = horizon  # a crossing is reported once it is this close in time, s
+        self.last: tuple[str, str, int | None] | None = None
+        self.seen_crossers: set[int] = set()
+
+    def events(self, decision: Decision) -> list[tuple[str, str, int | None, str | None, str]]:
+        found = []
+        for note in decision.notes:
+            soon = min(note.robot_time, note.obstacle_time) <= self.horizon
+            if note.letter in "cd" and soon and note.obstacle.id not in self.seen_crossers:
+                self.seen_crossers.add(note.obstacle.id)
+                found.append((note.letter, "keep", note.obstacle.id, note.obstacle.kind,
+                              f"meets the path {note.obstacle_time:.1f} s from now, "
+                              f"robot in {note.robot_time:.1f} s"))
+        current = (decision.scenario, decision.action, decision.obstacle)
+        if current != self.last:
+            previous = self.last
+            self.last = current
+            action = decision.action
+            if previous is not None and previous[1] != "keep" and action == "keep":
+                action = "resume"
+            found.append((decision.scenario, action, decision.obstacle, decision.kind,
+                          f"speed {decision.speed:.2f} m/s toward "
+                          f"({decision.target[0]:.2f}, {decision.target[1]:.2f})"))
+        return found
 
 
 class Service:
     def __init__(self, node: Node, params: Params) -> None:
         self.node = node
-        self.params = params
+        self.planner = Planner(params)
+        self.log = EventLog(params.horizon)
         self.commands = node.publisher(keys.CMD_VEL, VelocityCommand, urgent=True)
+        self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
         self.gate = StampGate()
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
@@ -30,28 +72,18 @@ class Service:
             self.node.reject(self.node.keys.of(keys.TRACKS), "out_of_order",
                              f"tracks stamped {tracks.stamp} after {self.gate.last}")
             return
-        p = self.params
         pose = tracks.pose
-        at_goal = math.hypot(p.goal[0] - pose.x, p.goal[1] - pose.y) <= p.goal_tolerance / 2
-        if at_goal:
-            v, omega = 0.0, 0.0
-        else:
-            v, omega = command_toward(
-                pose.x, pose.y, pose.heading, p.goal, p.cruise_speed, p.heading_gain, p.max_omega
-            )
-        self.commands.publish(
-            VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(), v=v, omega=omega)
-        )
-        self.state.publish(
-            PlannerState(
-                stamp=tracks.stamp,
-                seq=self.state.next_seq(),
-                scenario="a",
-                action="goal" if at_goal else "keep",
-                target=p.goal,
-                speed=v,
-            )
-        )
+        decision = self.planner.step((pose.x, pose.y, pose.heading), obstacles_of(tracks),
+                                     tracks.stamp)
+        for letter, action, obstacle, kind, detail in self.log.events(decision):
+            self.events.publish(PlannerEvent(
+                stamp=tracks.stamp, seq=self.events.next_seq(), obstacle=obstacle,
+                kind=kind, scenario=letter, action=action, detail=detail))  # type: ignore[arg-type]
+        self.commands.publish(VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(),
+                                              v=decision.v, omega=decision.omega))
+        self.state.publish(PlannerState(
+            stamp=tracks.stamp, seq=self.state.next_seq(), scenario=decision.scenario,  # type: ignore[arg-type]
+            action=decision.action, target=decision.target, speed=decision.speed))  # type: ignore[arg-type]
 
 
 if __name__ == "__main__":

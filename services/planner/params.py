@@ -1,4 +1,4 @@
-"""Planner parameters, with the paper's values as defaults."""
+"""Planner parameters. The paper's values are the defaults where it gives them."""
 
 from __future__ import annotations
 
@@ -8,13 +8,92 @@ from pydantic import BaseModel, ConfigDict, Field
 class Params(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
+    # --- the mission ----------------------------------------------------------------
     goal: tuple[float, float] = Field((6.0, 0.0), description="global target, m")
     start: tuple[float, float] | None = Field(
         None, description="start of the global path, m; default: the first pose seen"
     )
     goal_tolerance: float = Field(0.25, gt=0, description="arrived within this distance, m")
+
+    # --- the robot ------------------------------------------------------------------
     cruise_speed: float = Field(0.1, gt=0, description="V_R, m/s")
     max_speed: float = Field(0.2, gt=0, description="top speed when speeding up, m/s")
     robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
     heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of heading error, 1/s")
     max_omega: float = Field(1.0, gt=0, description="turn rate limit, rad/s")
+
+    # --- the world model ------------------------------------------------------------
+    cell: float = Field(0.5, gt=0, description="grid resolution r, m (Eq. 2)")
+    window_radius: float = Field(4.0, gt=0, description="r_w: obstacles beyond are ignored, m")
+    safety_margin: float = Field(
+        0.1, ge=0, description="gap kept between footprints on top of both radii, m"
+    )
+    lookahead: float = Field(
+        1.0, gt=0, description="the robot steers for the global path this far ahead of its "
+        "projection on it, m: on the path that is straight on, off it a way back"
+    )
+
+    # --- collision prediction -------------------------------------------------------
+    horizon: float = Field(
+        12.0, gt=0, description="longest time ahead a meeting with a mover is acted on, s: "
+        "velocity errors grow with it, and the robot has time to answer a later one later"
+    )
+    moving_speed: float = Field(
+        0.03, ge=0, description="tracks slower than this are treated as standing still, m/s"
+    )
+    head_on_cos: float = Field(
+        -0.8, description="cos of the angle between motions below which a mover is head-on (f)"
+    )
+    threat_hysteresis: float = Field(
+        0.1, ge=0, description="extra margin an obstacle already answered must clear before "
+        "it stops counting as a threat, m"
+    )
+    same_way_cos: float = Field(
+        0.8, description="cos of the angle above which a mover goes the robot's way (g)"
+    )
+
+    confirm_time: float = Field(
+        2.0, ge=0, description="a standing obstacle is answered with a detour once seen this "
+        "long (perception needs up to 2 s to see a slow mover move), s"
+    )
+    confirm_distance: float = Field(
+        0.6, ge=0, description="... unless the path meets it closer than this, m"
+    )
+
+    # --- responses ------------------------------------------------------------------
+    speed_up_buffer: float = Field(
+        2.0, ge=0, description="(e): speed up only if the robot clears the meeting point "
+        "this long before the obstacle arrives, s"
+    )
+    min_slow_fraction: float = Field(
+        0.4, gt=0, le=1, description="(e): slowing below this fraction of V_R means stopping"
+    )
+    follow_gap: float = Field(0.6, gt=0, description="(g): free distance kept behind, m")
+    follow_gain: float = Field(0.3, gt=0, description="(g): speed change per m of gap error, 1/s")
+    stop_gap: float = Field(0.25, ge=0, description="(g): stop below this free distance, m")
+
+    # --- simplified Morphin (Eq. 17) ------------------------------------------------
+    kappa: tuple[float, float, float] = Field(
+        (1.0, 1.3, 0.6), description="kappa_1..3: weights of |G|, Delta L and W (paper values)"
+    )
+    fan_step_deg: float = Field(5.0, gt=0, description="angle between candidate paths, deg")
+    fan_max_deg: float = Field(85.0, gt=0, lt=90, description="widest candidate, deg")
+    extend_past: bool = Field(
+        True, description="beyond the paper: lengthen candidates by the clearance so the "
+        "sub-target lies past the obstacle instead of beside it (paper: False)"
+    )
+    switch_penalty: float = Field(
+        10.0, ge=0, description="beyond the paper: extra cost of re-planning a detour to the "
+        "other side of the obstacle than the one under way"
+    )
+    replan_slack: float = Field(
+        0.05, ge=0, description="on a detour, the margin may shrink by this much before the "
+        "way to the sub-target counts as blocked and the detour is planned again, m"
+    )
+    subtarget_reached: float = Field(
+        0.15, gt=0, description="a sub-target this close counts as reached, m"
+    )
+    resume_hysteresis: float = Field(
+        0.1, ge=0, description="extra clearance the direct way must have before a detour "
+        "is given up, m"
+    )

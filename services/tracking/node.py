@@ -17,11 +17,22 @@ Params = TrackingParams
 
 def track_message(track: TrackState) -> Track:
     return Track(
-        id=track.id, kind=track.kind, x=track.x, y=track.y, vx=track.vx, vy=track.vy,
-        speed=track.speed, heading=track.heading, radius=track.radius,
-        xi=min(max(track.xi, 0.0), 1.0), varsigma=min(max(track.varsigma, 0.0), 1.0),
+        id=track.id,
+        kind=track.kind,
+        x=track.x,
+        y=track.y,
+        vx=track.vx,
+        vy=track.vy,
+        speed=track.speed,
+        heading=track.heading,
+        radius=track.radius,
+        xi=min(max(track.xi, 0.0), 1.0),
+        varsigma=min(max(track.varsigma, 0.0), 1.0),
         alpha_o_deg=track.alpha_o_deg % 360.0 if math.isfinite(track.alpha_o_deg) else 0.0,
-        age=track.age, cells=track.box, area=track.area, visible=track.visible,
+        age=track.age,
+        cells=track.box,
+        area=track.area,
+        visible=track.visible,
     )
 
 
@@ -39,14 +50,21 @@ class Service:
             self.tracks.republish()
             return
         if order == "old":
-            self.node.reject(self.node.keys.of(keys.OBSTACLES), "out_of_order",
-                             f"chain stamped {chain.stamp} after {self.gate.last}")
+            self.node.reject(
+                self.node.keys.of(keys.OBSTACLES),
+                "out_of_order",
+                f"chain stamped {chain.stamp} after {self.gate.last}",
+            )
             return
         clusters = from_message(chain)
         states = self.tracker.update(chain.stamp, clusters.pose, clusters)
         self.tracks.publish(
-            TrackList(stamp=chain.stamp, seq=self.tracks.next_seq(), pose=chain.pose,
-                      tracks=[track_message(t) for t in states])
+            TrackList(
+                stamp=chain.stamp,
+                seq=self.tracks.next_seq(),
+                pose=chain.pose,
+                tracks=[track_message(t) for t in states],
+            )
         )
 
 

@@ -1,0 +1,334 @@
+"""Adaptive-threshold nearest-neighbour clustering of one laser scan (paper Section 3.1-3.2).
+
+Pure numpy: :func:`cluster_scan` takes the scan in the ROS LaserScan convention and the robot
+pose at scan time, and returns a :class:`Clusters` record, one row per obstacle in scan order
+(the obstacle chain O_chain(t) of Eq. 4).
+
+Conventions
+-----------
+* Beam ``i`` points at ``alpha_i = angle_min + i * angle_increment`` relative to the robot
+  heading, counter-clockwise positive (REP 103). For the paper's 180-degree scanner
+  ``angle_min = -pi/2``: beam 0 looks to the right and the scan runs right to left, which is
+  the paper's 0 -> 180 degree order.
+* Eq. 1 in the paper reads ``theta_R - alpha_i`` because the paper counts alpha clockwise from
+  the heading; with alpha counter-clockwise the same point is
+  ``(x_R + rho cos(theta_R + alpha), y_R + rho sin(theta_R + alpha))``.
+* A reading that is not finite, ``< range_min`` or ``>= range_max`` is "no return".
+* Scans up to 360 degrees; a cluster never wraps from the last beam to the first.
+
+Decisions on points the paper leaves open
+-----------------------------------------
+* Edges of S_k (Eq. 6). The paper builds the box from the pairs (min rho, min alpha) and
+  (max rho, max alpha), which are generally not points of the cluster, and whose box can miss
+  cells the obstacle covers (a surface seen obliquely has its nearest point in the middle) or
+  shrink to a line. Here S_k is the bounding box, in grid cells, of *every* point of the
+  cluster (Eq. 2 applied to each point): it always holds every cell the cluster touches, does
+  not depend on which way the scan runs, and costs two reductions.
+* Eq. 3 uses ``rho`` of the current point (the later beam of the pair) and the scan's own
+  ``angle_increment``. Beams outside the window are skipped, so the two points compared are
+  consecutive *available* points, as the paper's example (rho_2, rho_4) does.
+* ``chord_centre`` and ``radius`` go beyond the paper. The Eq. 5 centre lies on the visible
+  surface; for a round obstacle it sits about 0.8 radius in front of the true centre and
+  swings with the bearing as the robot moves. The midpoint of the two end points is within
+  radius^2 / distance of a disc's centre and is exactly the centre of a box seen corner-on,
+  so it serves as the footprint centre; the tracker can use either.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.services.perception.params import PerceptionParams
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+Pose = tuple[float, float, float]
+
+# Codes for what lies beyond each end of a cluster (in scan order), see Clusters.edge_start.
+EDGE_FREE: Final = 0
+"""The neighbouring beam has no return or hits something farther: the cluster ends here."""
+EDGE_OCCLUDED: Final = 1
+"""The neighbouring beam hits something nearer: the obstacle may go on behind it."""
+EDGE_CLIPPED: Final = 2
+"""The surface goes on outside the sliding window, or the cluster touches the end of the scan."""
+
+
+@dataclass(frozen=True, eq=False)
+class Clusters:
+    """The obstacle chain of one scan: one row per cluster, in scan order.
+
+    All coordinates are global (metres, x right, y up); grid indices follow Eq. 2
+    (``floor(x / cell + 1/2)``).
+
+    Attributes:
+        centre: (n, 2) Eq. 5 centre Z_k: the point at mean alpha and mean rho, made global
+            with Eq. 1.
+        mean_rho: (n,) mean range of the cluster's beams, metres (Eq. 5).
+        mean_alpha: (n,) mean beam angle relative to the heading, radians (Eq. 5).
+        box: (n, 4) grid box ``ix_min, ix_max, iy_min, iy_max`` (inclusive) of S_k (Eq. 6): the
+            bounding box, in cells, of every point of the cluster.
+        area: (n,) S_k, number of cells in ``box`` (Eq. 6).
+        beams: (n, 2) first and last beam index of the cluster (inclusive).
+        n_beams: (n,) beams in the cluster (beams outside the window or without a return
+            inside the span do not count).
+        first_point: (n, 2) global point of the first beam of the cluster.
+        last_point: (n, 2) global point of the last beam of the cluster.
+        chord_centre: (n, 2) midpoint of ``first_point`` and ``last_point``: a footprint
+            centre that moves much less with the viewpoint than ``centre`` (see below).
+        radius: (n,) largest distance from ``chord_centre`` to a point of the cluster,
+            metres: a footprint radius for the visible part (the hidden back is unknown).
+        edge_start: (n,) what lies before the first beam: EDGE_FREE / EDGE_OCCLUDED /
+            EDGE_CLIPPED.
+        edge_end: (n,) the same after the last beam.
+        pose: robot pose (x, y, heading rad) at scan time, used for Eq. 1.
+        cell: grid resolution r, metres (Eq. 2).
+    """
+
+    centre: FloatArray
+    mean_rho: FloatArray
+    mean_alpha: FloatArray
+    box: IntArray
+    area: IntArray
+    beams: IntArray
+    n_beams: IntArray
+    first_point: FloatArray
+    last_point: FloatArray
+    chord_centre: FloatArray
+    radius: FloatArray
+    edge_start: IntArray
+    edge_end: IntArray
+    pose: Pose
+    cell: float
+    moved: FloatArray | None = None
+    """(n,) free-space motion score in [0, 1] (``motion_cue.py``); None when not measured."""
+
+    def __len__(self) -> int:
+        return int(self.area.shape[0])
+
+    @property
+    def partial(self) -> npt.NDArray[np.bool_]:
+        """(n,) True where either end is occluded or clipped: only part of the obstacle seen."""
+        start_hidden = self.edge_start != EDGE_FREE
+        end_hidden = self.edge_end != EDGE_FREE
+        partial: npt.NDArray[np.bool_] = start_hidden | end_hidden
+        return partial
+
+    @classmethod
+    def empty(cls, pose: Pose = (0.0, 0.0, 0.0), cell: float = 0.5) -> Clusters:
+        """A chain with no obstacles."""
+        f1 = np.zeros(0, dtype=np.float64)
+        f2 = np.zeros((0, 2), dtype=np.float64)
+        i1 = np.zeros(0, dtype=np.int64)
+        return cls(
+            centre=f2,
+            mean_rho=f1,
+            mean_alpha=f1,
+            box=np.zeros((0, 4), dtype=np.int64),
+            area=i1,
+            beams=np.zeros((0, 2), dtype=np.int64),
+            n_beams=i1,
+            first_point=f2,
+            last_point=f2,
+            chord_centre=f2,
+            radius=f1,
+            edge_start=i1,
+            edge_end=i1,
+            pose=pose,
+            cell=cell,
+        )
+
+
+def grid_index(coord: npt.ArrayLike, cell: float) -> IntArray:
+    """Eq. 2: grid index ``floor(coord / r + 1/2)`` (cell k is centred on k * r)."""
+    return np.floor(np.asarray(coord, dtype=np.float64) / cell + 0.5).astype(np.int64)
+
+
+def box_area(box: npt.ArrayLike) -> IntArray:
+    """Eq. 6: cells in an inclusive grid box ``(ix_min, ix_max, iy_min, iy_max)``."""
+    b = np.asarray(box, dtype=np.int64)
+    return (b[..., 1] - b[..., 0] + 1) * (b[..., 3] - b[..., 2] + 1)
+
+
+def join_threshold(
+    rho: npt.ArrayLike, angle_increment: float, params: PerceptionParams
+) -> FloatArray:
+    """Eq. 3: distance above which two consecutive points start a new cluster.
+
+    ``theta = lambda * rho * sin(d_alpha) + gap_floor``; ``d_alpha`` is the scan's own angular
+    step (0.5 degrees for the paper's scanner), ``rho`` the range of the current point.
+    ``gap_floor`` is 0 in the paper (see PerceptionParams).
+    """
+    step = math.sin(abs(angle_increment))
+    return params.lambda_ * np.asarray(rho, dtype=np.float64) * step + params.gap_floor
+
+
+def cluster_scan(
+    ranges: npt.ArrayLike,
+    angle_min: float,
+    angle_increment: float,
+    range_min: float,
+    range_max: float,
+    pose: Pose,
+    params: PerceptionParams,
+) -> Clusters:
+    """Cluster one scan into the obstacle chain O_chain(t) (Eqs. 1-6).
+
+    Args:
+        ranges: (n,) ranges in metres, beam i at ``angle_min + i * angle_increment``.
+        angle_min: angle of beam 0 relative to the heading, radians (CCW positive).
+        angle_increment: angle between consecutive beams, radians (the Eq. 3 step).
+        range_min: readings below this are no return, metres.
+        range_max: readings at or above this are no return, metres.
+        pose: robot pose at scan time (x, y, heading rad), global frame.
+        params: window, grid and clustering parameters.
+
+    Returns:
+        The clusters in scan order. Points with rho > ``window_radius`` are ignored; two
+        consecutive points inside the window (skipping beams that are not) join when their
+        Euclidean distance is at most the Eq. 3 threshold of the current point.
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    cell = params.cell
+    step = math.sin(abs(angle_increment))
+    lam_step = params.lambda_ * step
+    floor_ = params.gap_floor
+    # NaN compares False everywhere, so it drops out as "no return" like inf does.
+    valid = (r >= range_min) & (r < range_max)
+    idx = np.flatnonzero(valid & (r <= params.window_radius))
+    if idx.size == 0:
+        return Clusters.empty(pose, cell)
+
+    x_r, y_r, th_r = pose
+    rho = r[idx]
+    alpha = angle_min + idx * angle_increment
+    # Eq. 1 (alpha counter-clockwise, hence theta_R + alpha; the paper writes theta_R - alpha).
+    ang = th_r + alpha
+    px = x_r + rho * np.cos(ang)
+    py = y_r + rho * np.sin(ang)
+
+    # Eq. 3: a new cluster starts where the distance to the previous point exceeds theta
+    # (compared squared, both sides are non-negative).
+    dx = px[1:] - px[:-1]
+    dy = py[1:] - py[:-1]
+    thr = lam_step * rho[1:] + floor_
+    breaks = (dx * dx + dy * dy > thr * thr).nonzero()[0] + 1
+    m = idx.size
+    k = breaks.size + 1
+    starts = np.empty(k, dtype=np.int64)
+    starts[0] = 0
+    starts[1:] = breaks
+    ends = np.empty(k, dtype=np.int64)
+    ends[:-1] = breaks - 1
+    ends[-1] = m - 1
+    counts = ends - starts + 1
+
+    if params.min_beams > 1:
+        keep = counts >= params.min_beams
+        if not keep.all():
+            starts, ends, counts = starts[keep], ends[keep], counts[keep]
+            if starts.size == 0:
+                return Clusters.empty(pose, cell)
+            # Gather the kept runs back to back so that reduceat works on them.
+            sel = _run_selector(starts, counts)
+            rho, alpha, px, py = rho[sel], alpha[sel], px[sel], py[sel]
+            idx = idx[sel]
+            ends = np.cumsum(counts) - 1
+            starts = ends - counts + 1
+    k = starts.size
+
+    # Eq. 5: mean alpha and mean rho, then Eq. 1 for the global centre.
+    mean_rho = np.add.reduceat(rho, starts) / counts
+    mean_alpha = np.add.reduceat(alpha, starts) / counts
+    ang_c = th_r + mean_alpha
+    centre = np.empty((k, 2))
+    centre[:, 0] = x_r + mean_rho * np.cos(ang_c)
+    centre[:, 1] = y_r + mean_rho * np.sin(ang_c)
+
+    # Eq. 2 on every point, Eq. 6 box over all of them (S_k's edges, see the module notes).
+    gx = np.floor(px / cell + 0.5).astype(np.int64)
+    gy = np.floor(py / cell + 0.5).astype(np.int64)
+    box = np.empty((k, 4), dtype=np.int64)
+    box[:, 0] = np.minimum.reduceat(gx, starts)
+    box[:, 1] = np.maximum.reduceat(gx, starts)
+    box[:, 2] = np.minimum.reduceat(gy, starts)
+    box[:, 3] = np.maximum.reduceat(gy, starts)
+    area = (box[:, 1] - box[:, 0] + 1) * (box[:, 3] - box[:, 2] + 1)
+
+    first_point = np.empty((k, 2))
+    first_point[:, 0] = px[starts]
+    first_point[:, 1] = py[starts]
+    last_point = np.empty((k, 2))
+    last_point[:, 0] = px[ends]
+    last_point[:, 1] = py[ends]
+    chord = 0.5 * (first_point + last_point)
+    ex = px - chord[:, 0].repeat(counts)
+    ey = py - chord[:, 1].repeat(counts)
+    radius = np.sqrt(np.maximum.reduceat(ex * ex + ey * ey, starts))
+
+    beams = np.empty((k, 2), dtype=np.int64)
+    beams[:, 0] = idx[starts]
+    beams[:, 1] = idx[ends]
+    edges = _edge_codes(r, valid, beams, angle_increment, params)
+
+    return Clusters(
+        centre=centre,
+        mean_rho=mean_rho,
+        mean_alpha=mean_alpha,
+        box=box,
+        area=area,
+        beams=beams,
+        n_beams=counts,
+        first_point=first_point,
+        last_point=last_point,
+        chord_centre=chord,
+        radius=radius,
+        edge_start=edges[:, 0],
+        edge_end=edges[:, 1],
+        pose=(float(x_r), float(y_r), float(th_r)),
+        cell=cell,
+    )
+
+
+def _run_selector(starts: IntArray, counts: IntArray) -> IntArray:
+    """Indices of the points of the kept runs, run after run."""
+    total = int(counts.sum())
+    offs = np.concatenate(([0], np.cumsum(counts)[:-1]))
+    return np.arange(total) - np.repeat(offs - starts, counts)
+
+
+def _edge_codes(
+    r: FloatArray,
+    valid: npt.NDArray[np.bool_],
+    beams: IntArray,
+    angle_increment: float,
+    params: PerceptionParams,
+) -> IntArray:
+    """(k, 2) codes for what lies beside each end of each cluster (before first, after last).
+
+    The neighbouring beam (first - 1, last + 1) is looked at:
+
+    * outside the scan -> EDGE_CLIPPED (the obstacle may go on outside the field of view);
+    * no return -> EDGE_FREE;
+    * a return beyond the window that would have joined the cluster (Eq. 3) -> EDGE_CLIPPED;
+    * a return nearer than the edge point by more than the join threshold -> EDGE_OCCLUDED;
+    * anything else (background behind, or a surface that did not join) -> EDGE_FREE.
+    """
+    nb = beams + np.array([-1, 1], dtype=np.int64)
+    outside = (nb < 0) | (nb >= r.shape[0])
+    nb[outside] = 0
+    has = valid[nb] & ~outside
+    rho_e = r[beams]
+    rho_n = np.where(has, r[nb], 0.0)  # no arithmetic on inf / NaN readings
+    lam_step = params.lambda_ * math.sin(abs(angle_increment))
+    # Distance between the two points by the law of cosines (the angle between them is known).
+    d2 = rho_e * rho_e + rho_n * rho_n - (2.0 * math.cos(angle_increment)) * rho_e * rho_n
+    thr = lam_step * np.maximum(rho_e, rho_n) + params.gap_floor
+    codes = np.zeros(beams.shape, dtype=np.int64)
+    codes[has & (rho_n < rho_e - (lam_step * rho_e + params.gap_floor))] = EDGE_OCCLUDED
+    codes[outside | (has & (rho_n > params.window_radius) & (d2 <= thr * thr))] = EDGE_CLIPPED
+    return codes

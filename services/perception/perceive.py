@@ -1,0 +1,29 @@
+"""Perception for one scan: clustering (Eqs. 1-6) plus the free-space motion cue."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from zenav.schemas.messages import LaserScan
+from zenav.services.perception.clustering import Clusters, Pose, cluster_scan
+from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot
+from zenav.services.perception.params import PerceptionParams
+
+
+class Perceiver:
+    """Turns each scan, with the pose it was taken from, into the obstacle chain."""
+
+    def __init__(self, params: PerceptionParams) -> None:
+        self.params = params
+        self.cue = MotionCue(params.motion_baselines, params.motion_margin, params.motion_reach,
+                             params.window_radius)
+
+    def process(self, scan: LaserScan, pose: Pose) -> Clusters:
+        clusters = cluster_scan(scan.ranges, scan.angle_min, scan.angle_increment,
+                                scan.range_min, scan.range_max, pose, self.params)
+        snapshot = ScanSnapshot(scan.stamp, pose, scan.ranges.astype(np.float64),
+                                scan.angle_min, scan.angle_increment, scan.range_max)
+        moved = self.cue.score(snapshot, scan.range_min, clusters.beams)
+        return dataclasses.replace(clusters, moved=moved)

@@ -1,0 +1,316 @@
+"""One planning cycle per scan: predict, pick the paper's response, steer (no I/O).
+
+The responses follow Section 3.5 of the paper:
+
+- (a), (c), (d): keep speed and heading;
+- (e): speed up if the robot clears the crossing point well before the obstacle
+  reaches it, else slow down so it arrives after the obstacle has left, else stop
+  until the obstacle has passed;
+- (g): slow down to keep a gap behind the slower obstacle, stop when too close;
+- (b), (f): simplified Morphin (``morphin.py``): a straight detour to a sub-target;
+- (h): all of them at once: the lowest speed any threat asks for, and a detour planned
+  around every obstacle in view when any threat needs one.
+
+Between decisions the robot heads for its target: a detour's sub-target, or else a
+point ``lookahead`` metres along the global path (the straight line from start to
+goal) beyond the robot's projection on it, which brings it back to the path after a
+detour.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
+from zenav.services.planner.follow import command_toward
+from zenav.services.planner.morphin import Mover, cells_on_segment, choose_detour
+from zenav.services.planner.params import Params
+from zenav.services.planner.prediction import Assessment, Obstacle, assess, cell_squares
+
+Vec = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Decision:
+    v: float
+    omega: float
+    target: tuple[float, float]
+    scenario: ScenarioLetter
+    action: Action
+    obstacle: int | None
+    kind: ObstacleKind | None
+    speed: float  # the speed asked for before steering, m/s
+    notes: tuple[Assessment, ...] = ()  # every obstacle that relates to the path
+
+
+@dataclass
+class Commitment:
+    """How the planner answers one threatening obstacle, kept while it threatens."""
+
+    letter: ScenarioLetter
+    action: Action
+
+
+@dataclass
+class Detour:
+    subtarget: Vec
+    obstacle: int
+    letter: str
+    side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
+
+
+class Planner:
+    """The paper's navigation decisions, one call per scan."""
+
+    def __init__(self, params: Params) -> None:
+        self.p = params
+        self.goal = np.asarray(params.goal, dtype=np.float64)
+        self.start: Vec | None = (
+            None if params.start is None else np.asarray(params.start, dtype=np.float64)
+        )
+        self.global_cells: set[tuple[int, int]] = set()
+        self.detour: Detour | None = None
+        self.commitments: dict[int, Commitment] = {}  # obstacle id -> how it is answered
+        self.first_seen: dict[int, float] = {}  # obstacle id -> stamp
+        if self.start is not None:
+            self.global_cells = cells_on_segment(self.start, self.goal, params.cell)
+
+    # -- geometry ----------------------------------------------------------------------
+
+    def path_target(self, robot: Vec) -> Vec:
+        """The point ``lookahead`` m beyond the robot's projection on the global path."""
+        assert self.start is not None
+        axis = self.goal - self.start
+        length = float(np.hypot(*axis))
+        if length < 1e-9:
+            return self.goal
+        unit = axis / length
+        s = float((robot - self.start) @ unit) + self.p.lookahead
+        return self.goal if s >= length else self.start + unit * max(s, 0.0)
+
+    def _assess_all(
+        self, robot: Vec, target: Vec, obstacles: list[Obstacle], extra_margin: float,
+        to_goal: bool,
+    ) -> list[Assessment]:
+        """Assess every obstacle against the robot heading for ``target``. Obstacles the
+        planner already answers keep ``threat_hysteresis`` more margin, so that a threat
+        does not flicker on and off with the estimates' noise."""
+        offset = target - robot
+        distance = float(np.hypot(*offset))
+        if distance < 1e-9:
+            return []
+        direction = offset / distance
+        length = distance
+        if to_goal:  # along the global path the robot goes on past the look-ahead point
+            length = max(distance, min(float(np.hypot(*(self.goal - robot))),
+                                       self.p.window_radius))
+        p = self.p
+        found = []
+        for ob in obstacles:
+            margin = p.safety_margin + extra_margin
+            if ob.id in self.commitments and ob.kind == "dynamic":
+                margin += p.threat_hysteresis
+            committed = self.commitments.get(ob.id)
+            a = assess(robot, direction, p.cruise_speed, length, ob, robot_radius=p.robot_radius,
+                       margin=margin, cell=p.cell, horizon=p.horizon,
+                       moving_speed=p.moving_speed, head_on_cos=p.head_on_cos,
+                       same_way_cos=p.same_way_cos,
+                       following=committed is not None and committed.letter == "g")
+            if a is not None:
+                found.append(a)
+        return found
+
+    # -- responses ---------------------------------------------------------------------
+
+    def crossing_response(self, a: Assessment, committed: Action | None) -> tuple[Action, float]:
+        """(e): speed up, slow down or stop so the robot and the obstacle are never in
+        the crossing zone together. A choice made earlier for this obstacle is kept while
+        it still works: speeding up while the robot still clears the zone first, slowing
+        while the slower speed stays above the floor; a stop lasts until the obstacle has
+        passed."""
+        p = self.p
+        ob_speed = float(np.hypot(*a.obstacle.velocity))
+        clearance = p.robot_radius + a.obstacle.radius + p.safety_margin
+        zone_in = a.obstacle_time - clearance / ob_speed
+        zone_out = a.obstacle_time + clearance / ob_speed
+        s = a.robot_distance
+        buffer = p.speed_up_buffer / 2 if committed == "speed_up" else p.speed_up_buffer
+        if committed in (None, "speed_up") and s > -clearance and (
+            (s + clearance) / p.max_speed + buffer < zone_in
+        ):
+            return "speed_up", p.max_speed
+        if committed != "stop" and zone_out > 0 and s - clearance > 0:
+            v = (s - clearance) / (zone_out + 1.0)
+            if v >= p.min_slow_fraction * p.cruise_speed:
+                return "slow", min(v, p.cruise_speed)
+        return "stop", 0.0
+
+    def follow_response(self, a: Assessment) -> tuple[Action, float]:
+        """(g): keep a gap behind a slower obstacle going the same way."""
+        p = self.p
+        free = a.along - p.robot_radius - a.obstacle.radius
+        if free < p.stop_gap:
+            return "stop", 0.0
+        v = a.along_speed + p.follow_gain * (free - p.follow_gap)
+        v = min(max(v, 0.0), p.cruise_speed)
+        return ("slow", v) if v > 1e-3 else ("stop", 0.0)
+
+    def _unconfirmed(self, a: Assessment, stamp: float) -> bool:
+        """A standing obstacle seen for less than ``confirm_time`` may yet turn out to move
+        (slow movers need a while to show it); while it is farther ahead than
+        ``confirm_distance`` the robot goes on and waits to see."""
+        p = self.p
+        young = stamp - self.first_seen.get(a.obstacle.id, stamp) < p.confirm_time
+        return (a.letter == "b" and young and a.obstacle.id not in self.commitments
+                and a.robot_distance > p.confirm_distance)
+
+    def _sticky(self, a: Assessment) -> Assessment:
+        """The scenario letter first given to a threat stays with it while it threatens."""
+        committed = self.commitments.get(a.obstacle.id)
+        if committed is None or committed.letter == a.letter:
+            return a
+        return dataclasses.replace(a, letter=committed.letter)
+
+    def plan_detour(self, robot: Vec, threat: Assessment, obstacles: list[Obstacle],
+                    fast: bool) -> Detour | None:
+        p = self.p
+        statics = [o for o in obstacles if o.kind != "dynamic"
+                   or math.hypot(*o.velocity) < p.moving_speed]
+        corners = [cell_squares(o.cells, p.cell) for o in statics]
+        lows = np.array([c[0] for c in corners]).reshape(-1, 2)
+        highs = np.array([c[1] for c in corners]).reshape(-1, 2)
+        movers = [Mover(np.asarray(o.position, dtype=np.float64),
+                        np.asarray(o.velocity, dtype=np.float64), o.radius)
+                  for o in obstacles if o not in statics]
+        clearance = p.robot_radius + p.safety_margin
+        axis = np.asarray(threat.direction, dtype=np.float64)
+        if threat.letter == "b":
+            # The centreline runs along the robot's way to the potential collision point
+            # (abreast of S_k's centre), and on past S_k's far side.
+            lo, hi = cell_squares(threat.obstacle.cells, p.cell)
+            corners = np.array([[lo[0], lo[1]], [lo[0], hi[1]], [hi[0], lo[1]], [hi[0], hi[1]]])
+            reach = (corners - robot) @ axis
+            middle = max(float(((lo + hi) / 2 - robot) @ axis), p.cell)
+            centre = robot + axis * middle
+            extra = max(float(reach.max()) - middle, 0.0) + clearance
+        else:  # to the potential collision point, and past the mover's footprint
+            centre = robot + axis * max(threat.robot_distance, p.cell)
+            extra = clearance + threat.obstacle.radius
+        side = self.detour.side if self.detour is not None else 0
+        choice = choose_detour(
+            robot, centre, self.goal, self.global_cells, (lows, highs), movers,
+            speed=p.max_speed if fast else p.cruise_speed, cell=p.cell,
+            robot_radius=p.robot_radius, margin=p.safety_margin, kappa=p.kappa,
+            fan_step=math.radians(p.fan_step_deg), fan_max=math.radians(p.fan_max_deg),
+            extra_length=extra if p.extend_past else 0.0, side=side,
+            switch_penalty=p.switch_penalty,
+        )
+        if choice.best is None:
+            return None
+        return Detour(np.asarray(choice.best.end), threat.obstacle.id, threat.letter,
+                      1 if choice.best.g > 0 else -1)
+
+    # -- the cycle ---------------------------------------------------------------------
+
+    def step(
+        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float = 0.0
+    ) -> Decision:
+        p = self.p
+        for ob in obstacles:
+            self.first_seen.setdefault(ob.id, stamp)
+        live = {ob.id for ob in obstacles}
+        self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
+        robot = np.array(pose[:2], dtype=np.float64)
+        if self.start is None:
+            self.start = robot.copy()
+            self.global_cells = cells_on_segment(self.start, self.goal, p.cell)
+        goal_xy = (float(self.goal[0]), float(self.goal[1]))
+        if float(np.hypot(*(self.goal - robot))) <= p.goal_tolerance / 2:
+            self.detour = None
+            return Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0)
+
+        in_window = [o for o in obstacles
+                     if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+        path_target = self.path_target(robot)
+
+        if self.detour is not None:
+            reached = float(np.hypot(*(self.detour.subtarget - robot))) < p.subtarget_reached
+            direct = self._assess_all(robot, path_target, in_window, p.resume_hysteresis,
+                                      to_goal=True)
+            if reached or not any(a.threat and a.letter in "bf" for a in direct):
+                self.detour = None
+
+        target = self.detour.subtarget if self.detour is not None else path_target
+        # On a detour, only a clear obstruction of the way to the sub-target re-plans it,
+        # not the few centimetres the robot drifts from the line it planned.
+        slack = -p.replan_slack if self.detour is not None else 0.0
+        notes = self._assess_all(robot, target, in_window, slack, to_goal=self.detour is None)
+        # A "new" obstacle has been seen once: it is answered from the next scan on, when
+        # its type is known (the motor bridge's stop zone covers the meantime).
+        threats = [self._sticky(a) for a in notes
+                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)]
+        threat_ids = {a.obstacle.id for a in threats}
+        self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}
+
+        speed, action = p.cruise_speed, cast(Action, "keep")
+        lead: Assessment | None = None
+        needs_detour = [a for a in threats if a.letter in "bf"]
+        if needs_detour:
+            lead = min(needs_detour, key=lambda a: a.robot_distance)
+            fast = lead.letter == "f"
+            detour = self.plan_detour(robot, lead, in_window, fast)
+            if detour is None:
+                speed, action = 0.0, "stop"
+            else:
+                self.detour = detour
+                target = detour.subtarget
+                action = "morphin"
+                speed = p.max_speed if fast else p.cruise_speed
+            for a in needs_detour:
+                self.commitments[a.obstacle.id] = Commitment(a.letter, action)
+
+        responses: list[tuple[float, Action, Assessment]] = []  # (speed, action, why)
+        for a in threats:
+            if a.letter not in "eg":
+                continue
+            committed = self.commitments.get(a.obstacle.id)
+            if a.letter == "e":
+                act, v = self.crossing_response(a, committed.action if committed else None)
+            else:
+                act, v = self.follow_response(a)
+            self.commitments[a.obstacle.id] = Commitment(a.letter, act)
+            responses.append((v, act, a))
+        if responses:
+            v, act, slowest = min(responses, key=lambda r: r[0])
+            if action == "morphin":
+                speed = min(speed, v)
+                if speed <= 0.0:
+                    action, lead = "stop", slowest
+            else:
+                speed, action, lead = v, act, slowest
+
+        if lead is None and self.detour is not None:
+            action = "morphin"  # still on the way to a sub-target
+        letter: ScenarioLetter
+        if len(threats) > 1:
+            letter = "h"
+        elif lead is not None:
+            letter = lead.letter
+        elif self.detour is not None:
+            letter = self.detour.letter
+        else:
+            letter = "a"
+
+        tx, ty = float(target[0]), float(target[1])
+        v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,
+                                  p.heading_gain, p.max_omega)
+        obstacle = lead.obstacle.id if lead is not None else (
+            self.detour.obstacle if self.detour is not None else None)
+        kind = lead.obstacle.kind if lead is not None else None
+        return Decision(v, omega, (tx, ty), letter, action, obstacle, kind, speed, tuple(notes))

@@ -1,0 +1,184 @@
+"""Collision prediction and the paper's eight scenarios (Section 3.4), pure geometry.
+
+The robot is assumed to go on straight toward its current target at its cruise speed;
+each obstacle at its tracked velocity. For every obstacle in the window this finds
+whether their footprints (robot radius + obstacle radius + a safety margin) would
+meet, where the two paths cross (the potential collision point, PCP), when each would
+get there, and which of the paper's scenarios it is:
+
+- (b) a static obstacle on the path;
+- (c) a crosser that passes the PCP before the robot arrives;
+- (d) a crosser that arrives after the robot has passed;
+- (e) a crosser that would meet the robot at the PCP;
+- (f) a mover coming head-on along the path;
+- (g) a slower mover ahead going the same way.
+
+(a) is the absence of all of these and (h) more than one threat at once; both are
+decided by the caller, which sees every obstacle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.schemas.messages import ObstacleKind, ScenarioLetter
+
+Vec = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """What the planner knows of one tracked obstacle (global frame, m and m/s)."""
+
+    id: int
+    kind: ObstacleKind
+    position: tuple[float, float]
+    velocity: tuple[float, float]
+    radius: float
+    cells: tuple[int, int, int, int]  # grid box ix_min, ix_max, iy_min, iy_max (Eq. 6)
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """How one obstacle relates to the robot's intended motion."""
+
+    obstacle: Obstacle
+    letter: ScenarioLetter  # "b".."g"
+    threat: bool  # the footprints would meet if nothing changes
+    pcp: tuple[float, float]  # potential collision point (b: nearest point of the path)
+    robot_distance: float  # along the robot's path to the PCP, m
+    robot_time: float  # robot at the PCP at cruise speed, s
+    obstacle_time: float  # obstacle at the PCP, s (inf for a static one)
+    min_gap: float  # smallest predicted distance between centres minus clearance, m
+    along: float  # obstacle centre ahead of the robot along its path, m
+    along_speed: float  # obstacle velocity along the robot's path, m/s
+    direction: tuple[float, float]  # the robot's path, unit vector
+
+
+def closest_approach(rel_pos: Vec, rel_vel: Vec, t_max: float) -> tuple[float, float]:
+    """(time, distance) of the smallest |rel_pos + rel_vel t| for t in [0, t_max]."""
+    speed2 = float(rel_vel @ rel_vel)
+    t = 0.0 if speed2 < 1e-12 else min(max(-float(rel_pos @ rel_vel) / speed2, 0.0), t_max)
+    return t, float(np.hypot(*(rel_pos + rel_vel * t)))
+
+
+def cell_squares(cells: tuple[int, int, int, int], cell: float) -> tuple[Vec, Vec]:
+    """Lower-left and upper-right corners (m) of a grid box; cell i spans
+    [(i - 1/2) r, (i + 1/2) r] because Eq. 2 rounds x / r to the nearest integer."""
+    ix0, ix1, iy0, iy1 = cells
+    lo = np.array([(ix0 - 0.5) * cell, (iy0 - 0.5) * cell])
+    hi = np.array([(ix1 + 0.5) * cell, (iy1 + 0.5) * cell])
+    return lo, hi
+
+
+def gap_to_boxes(points: Vec, lows: Vec, highs: Vec) -> Vec:
+    """(n,) distance from each point (n, 2) to the nearest of the boxes (m, 2)+(m, 2)."""
+    if len(lows) == 0:
+        return np.full(len(points), np.inf)
+    below = lows[None, :, :] - points[:, None, :]
+    above = points[:, None, :] - highs[None, :, :]
+    outside = np.maximum(np.maximum(below, above), 0.0)
+    return np.asarray(np.hypot(outside[..., 0], outside[..., 1]).min(axis=1), dtype=np.float64)
+
+
+def path_points(start: Vec, direction: Vec, length: float, step: float) -> Vec:
+    """Points every ``step`` m along a straight path, both ends included."""
+    count = max(2, math.ceil(length / step) + 1)
+    s = np.linspace(0.0, length, count)
+    return start[None, :] + s[:, None] * direction[None, :]
+
+
+def line_crossing(p: Vec, d: Vec, c: Vec, u: Vec) -> tuple[float, float] | None:
+    """(s, q) with p + d s = c + u q for unit directions d, u; None when parallel."""
+    det = d[0] * (-u[1]) + u[0] * d[1]
+    if abs(det) < 1e-9:
+        return None
+    rhs = c - p
+    s = (rhs[0] * (-u[1]) + u[0] * rhs[1]) / det
+    q = (d[0] * rhs[1] - d[1] * rhs[0]) / det
+    return float(s), float(q)
+
+
+def assess(
+    robot: Vec,
+    direction: Vec,
+    speed: float,
+    path_length: float,
+    obstacle: Obstacle,
+    *,
+    robot_radius: float,
+    margin: float,
+    cell: float,
+    horizon: float,
+    moving_speed: float,
+    head_on_cos: float,
+    same_way_cos: float,
+    following: bool = False,
+) -> Assessment | None:
+    """Classify one obstacle against the robot going ``direction`` (unit) at ``speed``
+    for ``path_length`` m; None when it has nothing to do with the robot's path.
+
+    ``following``: the robot already follows this obstacle (g); it stays a threat while
+    it is ahead in the robot's lane, however slowly the robot now closes in."""
+    c = np.asarray(obstacle.position, dtype=np.float64)
+    w = np.asarray(obstacle.velocity, dtype=np.float64)
+    rel = c - robot
+    along = float(rel @ direction)
+    heading = (float(direction[0]), float(direction[1]))
+    obstacle_speed = float(np.hypot(*w))
+    clearance = robot_radius + obstacle.radius + margin
+    moving = obstacle.kind == "dynamic" and obstacle_speed >= moving_speed
+
+    if not moving:
+        # (b): does the path come within the clearance of the obstacle's grid area S_k?
+        lo, hi = cell_squares(obstacle.cells, cell)
+        points = path_points(robot, direction, path_length, cell / 4)
+        gaps = gap_to_boxes(points, lo[None, :], hi[None, :]) - (robot_radius + margin)
+        first = int(np.argmax(gaps < 0)) if (gaps < 0).any() else -1
+        if first < 0:
+            return None
+        s_hit = first * path_length / (len(points) - 1)
+        centre_s = min(max(along, 0.0), path_length)
+        pcp = robot + direction * centre_s
+        return Assessment(obstacle, "b", True, (float(pcp[0]), float(pcp[1])), s_hit,
+                          s_hit / speed if speed > 0 else math.inf, math.inf,
+                          float(gaps.min()), along, 0.0, heading)
+
+    t_path = min(horizon, path_length / speed) if speed > 0 else horizon
+    t_min, d_min = closest_approach(rel, w - direction * speed, t_path)
+    threat = d_min < clearance
+    gap = d_min - clearance
+    along_speed = float(w @ direction)
+    cos_phi = along_speed / obstacle_speed
+    u = w / obstacle_speed
+
+    if following and cos_phi >= same_way_cos and along > 0:
+        threat = threat or abs(float(rel[0] * direction[1] - rel[1] * direction[0])) < clearance
+    if cos_phi <= head_on_cos or cos_phi >= same_way_cos:
+        if not threat or along <= 0:
+            return None
+        letter: ScenarioLetter = "f" if cos_phi <= head_on_cos else "g"
+        meet = robot + direction * speed * t_min
+        return Assessment(obstacle, letter, True, (float(meet[0]), float(meet[1])),
+                          speed * t_min, t_min, t_min, gap, along, along_speed, heading)
+
+    crossing = line_crossing(robot, direction, c, u)
+    if crossing is None:
+        return None
+    s, q = crossing
+    pcp = robot + direction * s
+    robot_time = s / speed if speed > 0 else math.inf
+    obstacle_time = q / obstacle_speed
+    pcp_xy = (float(pcp[0]), float(pcp[1]))
+    if threat:
+        return Assessment(obstacle, "e", True, pcp_xy, s, robot_time, obstacle_time, gap, along,
+                          along_speed, heading)
+    if s <= 0 or s > path_length + clearance or q < -clearance:
+        return None  # the paths cross behind the robot, beyond its path, or already behind
+    passing: ScenarioLetter = "c" if obstacle_time < robot_time else "d"
+    return Assessment(obstacle, passing, False, pcp_xy, s, robot_time, obstacle_time, gap, along,
+                      along_speed, heading)

@@ -1,0 +1,48 @@
+"""The accuracy benchmark runs, and the smoothed estimate meets the targets on a simple case."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[2] / "bench" / "tracking_accuracy.py"
+
+
+def load_bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("tracking_accuracy", BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up by name
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_smoothed_estimate_meets_the_targets_at_noise_0_01() -> None:
+    bench: Any = load_bench()
+    smoothed = [m for m in bench.methods() if m.name == "smoothed"]
+    rows = bench.evaluate(
+        noises=(0.01,),
+        motions=("moving",),
+        movers=((0.76, 62.47),),
+        seeds=1,
+        duration=4.0,
+        method_list=smoothed,
+    )
+    (row,) = rows
+    assert row.acc_static >= bench.TARGET_ACCURACY
+    assert row.acc_dynamic >= bench.TARGET_ACCURACY
+    assert row.speed_p95 <= bench.TARGET_SPEED_REL
+    assert row.heading_p95 <= bench.TARGET_HEADING_DEG
+
+
+def test_main_prints_the_table(capsys: pytest.CaptureFixture[str]) -> None:
+    bench: Any = load_bench()
+    assert bench.main(["--seeds", "1", "--duration", "1.5", "--no-per-mover"]) == 0
+    out = capsys.readouterr().out
+    assert "smoothed" in out and "paper-1s" in out and ">=95%" in out
+    assert out.count("moving") >= 9  # 3 noises x 3 methods
