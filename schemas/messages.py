@@ -293,7 +293,7 @@ class BaseCommand(Message):
     TYPE = "base_command"
     v: Finite
     omega: Finite
-    reason: Literal["command", "stale", "idle"] = "command"
+    reason: Literal["command", "stale", "stop_zone", "idle"] = "command"
 
 
 # --- simulation only: never read by the navigation services --------------------------

@@ -397,3 +397,11 @@ def _problems(errors: Iterable[Any]) -> list[tuple[str, str]]:
             message = str(error["msg"]).removeprefix("Value error, ")
         result.append((_format_loc(loc), message))
     return result
+
+
+def dump_scenario(scenario: Scenario, path: str | Path) -> Path:
+    """Write ``scenario`` as a scenario YAML file that :func:`load_scenario` reads back."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    target = Path(path)
+    target.write_text(yaml.safe_dump(data, sort_keys=False))
+    return target

@@ -19,7 +19,7 @@ from zenav.run import apply_override, stack_params
 from zenav.schemas.messages import Pose2D, RawLaserFrame, Track, TrackList
 from zenav.services.laser_driver.node import Params as DriverParams
 from zenav.services.laser_driver.node import frame_to_scan
-from zenav.services.motor_bridge.node import Limiter
+from zenav.services.motor_bridge.node import CommandFilter
 from zenav.services.motor_bridge.node import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
@@ -53,6 +53,7 @@ class InProcessRun:
     simulation: Simulation
     cycles: list[Cycle] = field(default_factory=list)
     stage_seconds: StageTimes = field(default_factory=dict)
+    zone_stops: int = 0
 
 
 def run_inprocess(
@@ -69,7 +70,7 @@ def run_inprocess(
     perceiver = Perceiver(PerceptionParams.model_validate(params["perception"]))
     tracker = Tracker(TrackingParams.model_validate(params["tracking"]))
     planner = Planner(PlannerParams.model_validate(params["planner"]))
-    limiter = Limiter(BridgeParams.model_validate(params["motor_bridge"]))
+    bridge = CommandFilter(BridgeParams.model_validate(params["motor_bridge"]))
     log = EventLog(planner.p.horizon)
     run = InProcessRun(sim)
     times: StageTimes = {k: [] for k in ("perception", "tracking", "planner")}
@@ -96,7 +97,8 @@ def run_inprocess(
             times["perception"].append(t1 - t0)
             times["tracking"].append(t2 - t1)
             times["planner"].append(t3 - t2)
-            v, omega = limiter.apply(t, decision.v, decision.omega)
+            v, omega, reason = bridge.apply(t, decision.v, decision.omega, scan)
+            run.zone_stops += reason == "stop_zone"
             cycle = Cycle(t, clusters, tracks, decision, log.events(decision))
             run.cycles.append(cycle)
             if on_cycle is not None:

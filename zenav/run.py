@@ -50,7 +50,7 @@ def stack_params(
                     "goal_tolerance": robot.goal_tolerance, "cruise_speed": robot.speed,
                     "max_speed": robot.effective_max_speed, "robot_radius": robot.radius,
                     "cell": cell, "window_radius": min(8 * cell, laser.max_range)},
-        "motor_bridge": {"max_speed": robot.effective_max_speed,
+        "motor_bridge": {"max_speed": robot.effective_max_speed, "robot_radius": robot.radius,
                          "command_period": scan_period,
                          "stale_timeout": max(0.5, 3 * scan_period)},
     }

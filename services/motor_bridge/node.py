@@ -17,11 +17,14 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.schemas import keys
-from zenav.schemas.messages import BaseCommand, Odometry, VelocityCommand
+from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCommand
+from zenav.services.motor_bridge.stop_zone import stop_distance, zone_blocked
 from zenav.services.node import Node, StampGate
 from zenav.sim.kinematics import limit_velocity
 
 log = logging.getLogger(__name__)
+
+SCANS_KEPT = 8
 
 
 class Params(BaseModel):
@@ -43,6 +46,15 @@ class Params(BaseModel):
         "sim", description="'realtime' adds a wall-clock watchdog to the stamp-clock check"
     )
     watchdog_period: float = Field(0.05, gt=0, description="wall s between watchdog checks")
+    stop_zone: bool = Field(True, description="refuse forward motion toward a return in the "
+                            "zone ahead (reads the raw scan)")
+    robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
+    zone_side_margin: float = Field(0.02, ge=0, description="zone half-width beyond the "
+                                    "robot radius, m")
+    zone_margin: float = Field(0.08, ge=0, description="zone length beyond the robot's "
+                               "front at standstill, m")
+    zone_reaction: float = Field(0.3, ge=0, description="s of travel added to the zone: one "
+                                 "command period and some")
 
 
 class Limiter:
@@ -72,19 +84,66 @@ class Limiter:
         self.stamp = stamp
 
 
+Reason = Literal["command", "stop_zone"]
+
+
+class CommandFilter:
+    """Limits plus the stop zone: what reaches the base for one command (pure, no I/O)."""
+
+    def __init__(self, params: Params) -> None:
+        self.params = params
+        self.limiter = Limiter(params)
+
+    def blocked(self, scan: LaserScan | None, v: float) -> bool:
+        p = self.params
+        if not p.stop_zone or scan is None:
+            return False
+        ahead = stop_distance(v, p.zone_reaction, p.decel, p.zone_margin)
+        return zone_blocked(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_max,
+                            v, p.robot_radius, p.zone_side_margin, ahead)
+
+    def apply(
+        self, stamp: float, v: float, omega: float, scan: LaserScan | None
+    ) -> tuple[float, float, Reason]:
+        reason: Reason = "command"
+        if self.blocked(scan, max(v, self.limiter.v)):
+            v, reason = min(v, 0.0), "stop_zone"
+        v, omega = self.limiter.apply(stamp, v, omega)
+        if reason == "stop_zone":
+            v = min(v, 0.0)  # at once: the base's own deceleration limit applies
+            self.limiter.v = v
+        return v, omega, reason
+
+
 class Service:
     def __init__(self, node: Node, params: Params) -> None:
         self.node = node
         self.params = params
-        self.limiter = Limiter(params)
+        self.filter = CommandFilter(params)
+        self.limiter = self.filter.limiter
         self.base = node.publisher(keys.BASE_CMD, BaseCommand, reliable=True, urgent=True)
         self.gate = StampGate()
         self.now: float | None = None  # latest stamp seen: the stack's clock
         self.last_command_stamp: float | None = None
         self.last_command_wall = time.monotonic()
         self.stopped_for_staleness = False
+        self.scans: dict[float, LaserScan] = {}  # the latest few, by stamp
+        self.zone_stops = 0
+        node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
         node.subscribe(keys.CMD_VEL, VelocityCommand, self.on_command, depth=2)
         node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=8)
+
+    def on_scan(self, scan: LaserScan) -> None:
+        self.scans[scan.stamp] = scan
+        while len(self.scans) > SCANS_KEPT:
+            del self.scans[min(self.scans)]
+
+    def scan_for(self, stamp: float) -> LaserScan | None:
+        """The scan a command answers (same stamp), else the newest one not after it."""
+        if stamp in self.scans:
+            return self.scans[stamp]
+        earlier = [s for s in self.scans if s <= stamp]
+        return self.scans[max(earlier)] if earlier else None
 
     def on_command(self, command: VelocityCommand) -> None:
         order = self.gate.check(command.stamp)
@@ -101,10 +160,15 @@ class Service:
         self.last_command_stamp = command.stamp
         self.last_command_wall = time.monotonic()
         self.now = command.stamp if self.now is None else max(self.now, command.stamp)
-        v, omega = self.limiter.apply(command.stamp, command.v, command.omega)
-        self.base.publish(
-            BaseCommand(stamp=command.stamp, seq=self.base.next_seq(), v=v, omega=omega)
-        )
+        v, omega, reason = self.filter.apply(command.stamp, command.v, command.omega,
+                                             self.scan_for(command.stamp))
+        if reason == "stop_zone":
+            self.zone_stops += 1
+            if self.zone_stops == 1 or self.zone_stops % 50 == 0:
+                log.warning("stop zone: something ahead at t=%.2f; forward motion refused "
+                            "(%d times so far)", command.stamp, self.zone_stops)
+        self.base.publish(BaseCommand(stamp=command.stamp, seq=self.base.next_seq(), v=v,
+                                      omega=omega, reason=reason))
 
     def on_odometry(self, odometry: Odometry) -> None:
         self.now = odometry.stamp if self.now is None else max(self.now, odometry.stamp)

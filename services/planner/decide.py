@@ -117,8 +117,9 @@ class Planner:
             if ob.id in self.commitments and ob.kind == "dynamic":
                 margin += p.threat_hysteresis
             committed = self.commitments.get(ob.id)
+            horizon = p.horizon * (1.25 if committed is not None else 1.0)
             a = assess(robot, direction, p.cruise_speed, length, ob, robot_radius=p.robot_radius,
-                       margin=margin, cell=p.cell, horizon=p.horizon,
+                       margin=margin, cell=p.cell, horizon=horizon,
                        moving_speed=p.moving_speed, head_on_cos=p.head_on_cos,
                        same_way_cos=p.same_way_cos,
                        following=committed is not None and committed.letter == "g")
@@ -136,6 +137,8 @@ class Planner:
         passed."""
         p = self.p
         ob_speed = float(np.hypot(*a.obstacle.velocity))
+        if ob_speed < 1e-6:
+            return "stop", 0.0
         clearance = p.robot_radius + a.obstacle.radius + p.safety_margin
         zone_in = a.obstacle_time - clearance / ob_speed
         zone_out = a.obstacle_time + clearance / ob_speed
@@ -161,6 +164,53 @@ class Planner:
         v = min(max(v, 0.0), p.cruise_speed)
         return ("slow", v) if v > 1e-3 else ("stop", 0.0)
 
+    def safe_speed(
+        self, robot: Vec, direction: Vec, preferred: float, movers: list[Obstacle]
+    ) -> tuple[float, Obstacle | None]:
+        """The speed to go at along ``direction``: ``preferred`` if no mover would touch
+        the robot within ``safety_horizon`` s, else the nearest of stop, half cruise,
+        cruise and top speed that is free of contact, else the one that puts contact
+        off longest. Beyond the paper: it keeps the robot from stopping in a mover's way
+        or going on into one, whatever the scenario letter said."""
+        p = self.p
+        options = sorted({0.0, p.cruise_speed / 2, p.cruise_speed, p.max_speed, preferred},
+                         key=lambda v: (abs(v - preferred), -v))
+        best_v, best_t, best_who = preferred, -1.0, None
+        for v in options:
+            t, who = self._first_contact(robot, direction * v, movers)
+            if math.isinf(t):
+                return v, (best_who if v != preferred else None)
+            if v == preferred:
+                best_who = who
+            if t > best_t:
+                best_v, best_t = v, t
+        return best_v, best_who
+
+    def _first_contact(
+        self, robot: Vec, velocity: Vec, movers: list[Obstacle]
+    ) -> tuple[float, Obstacle | None]:
+        """Earliest time within the safety horizon at which a mover would come within
+        the clearance of the robot going at ``velocity``; (inf, None) if none does."""
+        p = self.p
+        first, who = math.inf, None
+        for ob in movers:
+            rel = np.asarray(ob.position) - robot
+            rel_v = np.asarray(ob.velocity) - velocity
+            clearance = p.robot_radius + ob.radius + p.safety_margin / 2
+            a = float(rel_v @ rel_v)
+            b = 2.0 * float(rel @ rel_v)
+            c = float(rel @ rel) - clearance * clearance
+            if c <= 0.0:
+                t = 0.0 if b < 0 else math.inf  # already close: only closing in counts
+            elif a < 1e-12 or b * b - 4 * a * c < 0:
+                t = math.inf
+            else:
+                t = (-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)
+                t = t if 0.0 <= t <= p.safety_horizon else math.inf
+            if t < first:
+                first, who = t, ob
+        return first, who
+
     def _unconfirmed(self, a: Assessment, stamp: float) -> bool:
         """A standing obstacle seen for less than ``confirm_time`` may yet turn out to move
         (slow movers need a while to show it); while it is farther ahead than
@@ -175,6 +225,8 @@ class Planner:
         committed = self.commitments.get(a.obstacle.id)
         if committed is None or committed.letter == a.letter:
             return a
+        if committed.letter not in "efg" or a.letter not in "efg":
+            return a  # it started or stopped moving: a different situation
         return dataclasses.replace(a, letter=committed.letter)
 
     def plan_detour(self, robot: Vec, threat: Assessment, obstacles: list[Obstacle],
@@ -263,8 +315,13 @@ class Planner:
         needs_detour = [a for a in threats if a.letter in "bf"]
         if needs_detour:
             lead = min(needs_detour, key=lambda a: a.robot_distance)
-            fast = lead.letter == "f"
+            # At cruise speed if a detour at that speed clears everything, else at top
+            # speed (a head-on mover may leave no time to step aside slowly).
+            fast = False
             detour = self.plan_detour(robot, lead, in_window, fast)
+            if detour is None and lead.letter == "f":
+                fast = True
+                detour = self.plan_detour(robot, lead, in_window, fast)
             if detour is None:
                 speed, action = 0.0, "stop"
             else:
@@ -295,10 +352,29 @@ class Planner:
             else:
                 speed, action, lead = v, act, slowest
 
+        movers = [o for o in in_window
+                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        offset = target - robot
+        if movers and float(np.hypot(*offset)) > 1e-9:
+            direction = offset / float(np.hypot(*offset))
+            safe, culprit = self.safe_speed(robot, direction, speed, movers)
+            if safe != speed and culprit is not None:
+                why = next((a for a in notes if a.obstacle.id == culprit.id), None)
+                if action != "morphin" or safe <= 0.0:
+                    action = "speed_up" if safe > speed else ("stop" if safe <= 0.0 else "slow")
+                speed = safe
+                if why is not None:
+                    lead = why
+                    if why not in threats:
+                        threats.append(why)
+
         if lead is None and self.detour is not None:
             action = "morphin"  # still on the way to a sub-target
         letter: ScenarioLetter
-        if len(threats) > 1:
+        answering = {a.obstacle.id for a in threats}
+        if self.detour is not None:
+            answering.add(self.detour.obstacle)  # still on the way round it
+        if len(answering) > 1:
             letter = "h"
         elif lead is not None:
             letter = lead.letter

@@ -5,7 +5,15 @@ and the planner's state for monitors."""
 from __future__ import annotations
 
 from zenav.schemas import keys
-from zenav.schemas.messages import PlannerEvent, PlannerState, TrackList, VelocityCommand
+from zenav.schemas.messages import (
+    Action,
+    ObstacleKind,
+    PlannerEvent,
+    PlannerState,
+    ScenarioLetter,
+    TrackList,
+    VelocityCommand,
+)
 from zenav.services.node import Node, StampGate
 from zenav.services.planner.decide import Decision, Planner
 from zenav.services.planner.params import Params
@@ -21,17 +29,26 @@ def obstacles_of(tracks: TrackList) -> list[Obstacle]:
     ]
 
 
+EventRow = tuple[ScenarioLetter, Action, int | None, ObstacleKind | None, str]
+
+RESUME_AFTER = 3
+"""Cycles without any threat before a return to plain driving is reported."""
+
+
 class EventLog:
-    """Decides which decisions are events: a change of scenario, action or obstacle, and
-    every crosser judged harmless ((c) or (d)) once."""
+    """Decides which decisions are events: every change of scenario, action or obstacle
+    (a return to plain driving once it has lasted ``RESUME_AFTER`` cycles, so a threat
+    that flickers off for one scan is not reported twice), and every crosser judged
+    harmless ((c) or (d)) once, when the crossing is within the planner's horizon."""
 
     def __init__(self, horizon: float) -> None:
-        self.horizon = horizon  # a crossing is reported once it is this close in time, s
+        self.horizon = horizon
         self.last: tuple[str, str, int | None] | None = None
+        self.calm = 0  # cycles in a row with nothing to answer
         self.seen_crossers: set[int] = set()
 
-    def events(self, decision: Decision) -> list[tuple[str, str, int | None, str | None, str]]:
-        found = []
+    def events(self, decision: Decision) -> list[EventRow]:
+        found: list[EventRow] = []
         for note in decision.notes:
             soon = min(note.robot_time, note.obstacle_time) <= self.horizon
             if note.letter in "cd" and soon and note.obstacle.id not in self.seen_crossers:
@@ -40,15 +57,20 @@ class EventLog:
                               f"meets the path {note.obstacle_time:.1f} s from now, "
                               f"robot in {note.robot_time:.1f} s"))
         current = (decision.scenario, decision.action, decision.obstacle)
-        if current != self.last:
-            previous = self.last
-            self.last = current
-            action = decision.action
-            if previous is not None and previous[1] != "keep" and action == "keep":
-                action = "resume"
-            found.append((decision.scenario, action, decision.obstacle, decision.kind,
-                          f"speed {decision.speed:.2f} m/s toward "
-                          f"({decision.target[0]:.2f}, {decision.target[1]:.2f})"))
+        plain = decision.scenario == "a" and decision.action == "keep"
+        self.calm = self.calm + 1 if plain else 0
+        if current == self.last or (plain and self.last is not None and 0 < self.calm
+                                    < RESUME_AFTER):
+            return found
+        action: Action = decision.action
+        if plain and self.last is not None:
+            action = "resume"
+        self.last = current
+        if decision.obstacle is not None:
+            self.seen_crossers.add(decision.obstacle)  # answered: not reported as (c)/(d)
+        found.append((decision.scenario, action, decision.obstacle, decision.kind,
+                      f"speed {decision.speed:.2f} m/s toward "
+                      f"({decision.target[0]:.2f}, {decision.target[1]:.2f})"))
         return found
 
 
@@ -78,12 +100,12 @@ class Service:
         for letter, action, obstacle, kind, detail in self.log.events(decision):
             self.events.publish(PlannerEvent(
                 stamp=tracks.stamp, seq=self.events.next_seq(), obstacle=obstacle,
-                kind=kind, scenario=letter, action=action, detail=detail))  # type: ignore[arg-type]
+                kind=kind, scenario=letter, action=action, detail=detail))
         self.commands.publish(VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(),
                                               v=decision.v, omega=decision.omega))
         self.state.publish(PlannerState(
-            stamp=tracks.stamp, seq=self.state.next_seq(), scenario=decision.scenario,  # type: ignore[arg-type]
-            action=decision.action, target=decision.target, speed=decision.speed))  # type: ignore[arg-type]
+            stamp=tracks.stamp, seq=self.state.next_seq(), scenario=decision.scenario,
+            action=decision.action, target=decision.target, speed=decision.speed))
 
 
 if __name__ == "__main__":

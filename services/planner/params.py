@@ -60,6 +60,11 @@ class Params(BaseModel):
         0.6, ge=0, description="... unless the path meets it closer than this, m"
     )
 
+    safety_horizon: float = Field(
+        6.0, gt=0, description="how far ahead the speed check looks for a mover touching "
+        "the robot, s"
+    )
+
     # --- responses ------------------------------------------------------------------
     speed_up_buffer: float = Field(
         2.0, ge=0, description="(e): speed up only if the robot clears the meeting point "

@@ -73,6 +73,10 @@ class TrackingParams(BaseModel):
     memory: float = Field(
         30.0, ge=0.0, description="seconds: how long a static track out of view is kept."
     )
+    memory_min_age: int = Field(
+        20, ge=1, description="frames: only a track seen this often is remembered out of "
+        "view (a mover glimpsed at the edge of the view is not made a standing ghost)."
+    )
     gate: float = Field(
         0.5,
         gt=0.0,

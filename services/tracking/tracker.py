@@ -300,7 +300,7 @@ class Tracker:
             for ti, t in enumerate(self._tracks)
             if t.last_seen == stamp
             or (t.age > p.new_frames and stamp - t.last_seen <= p.drop_after)
-            or (t.age > p.new_frames and t.kind == "static"
+            or (t.age >= p.memory_min_age and t.kind == "static"
                 and stamp - t.last_seen <= p.memory and not self._in_view(t, pose))
         ]
         out = [self._output(self._tracks[ti], dt, ti in visible and ti not in hold) for ti in live]
@@ -585,7 +585,9 @@ class Tracker:
         if cue:
             moving = t.last_moved is not None and stamp - t.last_moved <= p.moved_hold
             significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))
-            return "dynamic" if moving or (speed > p.dynamic_speed and significant) else "static"
+            fast = speed > p.dynamic_speed and significant
+            still_going = t.kind == "dynamic" and speed >= p.static_speed
+            return "dynamic" if moving or fast or still_going else "static"
         if t.kind == "dynamic":
             return "dynamic" if speed >= p.static_speed else "static"
         significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))

@@ -1,0 +1,46 @@
+"""A stop zone on the raw scan, independent of perception and planning (pure, no I/O).
+
+Like Nav2's collision monitor: a rectangle ahead of the robot, as wide as the robot plus
+a margin and as long as the robot needs to stop plus a margin. If the latest scan has a
+return inside it while the robot is asked to move forward, forward motion is refused;
+turning on the spot is still allowed, so the planner can steer away. Nothing behind the
+direction of travel counts. Since it reads the laser directly, a fault in perception,
+tracking or planning cannot drive the robot into what the laser sees.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+
+def stop_distance(v: float, reaction: float, decel: float, margin: float) -> float:
+    """How far ahead of the robot's front the zone reaches at speed ``v`` (m/s), m."""
+    v = max(v, 0.0)
+    return margin + v * reaction + v * v / (2.0 * decel)
+
+
+def zone_blocked(
+    ranges: npt.NDArray[np.float32],
+    angle_min: float,
+    angle_increment: float,
+    range_max: float,
+    v: float,
+    robot_radius: float,
+    side_margin: float,
+    ahead: float,
+) -> bool:
+    """Whether any return lies in the rectangle ahead of a robot asked to go ``v`` m/s.
+
+    The rectangle, in the robot frame (x ahead), spans 0 < x <= robot_radius + ahead and
+    |y| <= robot_radius + side_margin. ``v <= 0`` (not moving forward) is never blocked.
+    """
+    if v <= 0.0:
+        return False
+    r = np.asarray(ranges, dtype=np.float64)
+    angles = angle_min + angle_increment * np.arange(r.shape[0])
+    hit = r < range_max
+    x = r * np.cos(angles)
+    y = r * np.sin(angles)
+    inside = hit & (x > 0.0) & (x <= robot_radius + ahead) & (np.abs(y) <= robot_radius + side_margin)
+    return bool(inside.any())
