@@ -250,13 +250,20 @@ def cluster_scan(
     centre[:, 1] = y_r + mean_rho * np.sin(ang_c)
 
     # Eq. 2 on every point, Eq. 6 box over all of them (S_k's edges, see the module notes).
-    gx = np.floor(px / cell + 0.5).astype(np.int64)
-    gy = np.floor(py / cell + 0.5).astype(np.int64)
+    # The metric bounding box is shrunk by ``edge_inset`` on each side (never past its
+    # middle) before Eq. 2: an obstacle edge that lies on a cell boundary, as the edges
+    # of boxes laid out on the grid do, then stays in the obstacle's cell instead of
+    # spilling into the free one beside it, whichever way range noise moved the point.
+    inset = params.edge_inset
+    lo_x, hi_x = np.minimum.reduceat(px, starts), np.maximum.reduceat(px, starts)
+    lo_y, hi_y = np.minimum.reduceat(py, starts), np.maximum.reduceat(py, starts)
+    in_x = np.minimum(inset, (hi_x - lo_x) / 2)
+    in_y = np.minimum(inset, (hi_y - lo_y) / 2)
     box = np.empty((k, 4), dtype=np.int64)
-    box[:, 0] = np.minimum.reduceat(gx, starts)
-    box[:, 1] = np.maximum.reduceat(gx, starts)
-    box[:, 2] = np.minimum.reduceat(gy, starts)
-    box[:, 3] = np.maximum.reduceat(gy, starts)
+    box[:, 0] = np.floor((lo_x + in_x) / cell + 0.5)
+    box[:, 1] = np.floor((hi_x - in_x) / cell + 0.5)
+    box[:, 2] = np.floor((lo_y + in_y) / cell + 0.5)
+    box[:, 3] = np.floor((hi_y - in_y) / cell + 0.5)
     area = (box[:, 1] - box[:, 0] + 1) * (box[:, 3] - box[:, 2] + 1)
 
     first_point = np.empty((k, 2))

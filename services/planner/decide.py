@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
@@ -28,10 +29,18 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
+from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import command_toward
 from zenav.services.planner.morphin import Mover, cells_on_segment, choose_detour
 from zenav.services.planner.params import Params
-from zenav.services.planner.prediction import Assessment, Obstacle, assess, cell_squares
+from zenav.services.planner.prediction import (
+    Assessment,
+    Obstacle,
+    assess,
+    cell_squares,
+    gap_to_boxes,
+    path_points,
+)
 
 Vec = npt.NDArray[np.float64]
 
@@ -78,21 +87,95 @@ class Planner:
         self.detour: Detour | None = None
         self.commitments: dict[int, Commitment] = {}  # obstacle id -> how it is answered
         self.first_seen: dict[int, float] = {}  # obstacle id -> stamp
+        self.sides: dict[int, int] = {}  # obstacle id -> side it was last passed on
         if self.start is not None:
             self.global_cells = cells_on_segment(self.start, self.goal, params.cell)
 
     # -- geometry ----------------------------------------------------------------------
 
-    def path_target(self, robot: Vec) -> Vec:
-        """The point ``lookahead`` m beyond the robot's projection on the global path."""
+    def path_target(self, robot: Vec, statics: list[Obstacle] | None = None) -> Vec:
+        """Where to steer on the global path: ``lookahead`` m beyond the robot's
+        projection on it; or, when ``statics`` are given and the robot is off the path,
+        the farthest point of the path within the window that it can drive to in a
+        straight line clear of them (beyond the paper: it rejoins the path past the
+        obstacles it went round instead of cutting back into them)."""
         assert self.start is not None
+        p = self.p
         axis = self.goal - self.start
         length = float(np.hypot(*axis))
         if length < 1e-9:
             return self.goal
         unit = axis / length
-        s = float((robot - self.start) @ unit) + self.p.lookahead
-        return self.goal if s >= length else self.start + unit * max(s, 0.0)
+        s0 = float((robot - self.start) @ unit)
+        default = self.goal if s0 + p.lookahead >= length else (
+            self.start + unit * max(s0 + p.lookahead, 0.0))
+        off_path = abs(float(np.cross(unit, robot - self.start)))
+        if not statics or off_path < p.cell / 2:
+            return default
+        rejoin = self._rejoin_point(robot, statics)
+        if rejoin is None or float((rejoin - self.start) @ unit) < s0 + p.lookahead:
+            return default
+        return rejoin
+
+    def _to_goal(self, robot: Vec, lows: Vec, highs: Vec) -> Callable[[Vec], float]:
+        """Delta L's distance to the goal: around the standing obstacles (``field.py``),
+        or the paper's straight line when ``around_obstacles`` is off."""
+        p = self.p
+        if not p.around_obstacles or len(lows) == 0:
+            return lambda end: float(np.hypot(*(self.goal - end)))
+        reach = p.window_radius + 2.0
+        field = distance_field(
+            self.goal, lows, highs, np.minimum(robot, self.goal) - reach,
+            np.maximum(robot, self.goal) + reach, p.cell / 2,
+            p.robot_radius + p.safety_margin,
+        )
+        return field.at
+
+    def _way_on_cost(self, robot: Vec, end: Vec, to_goal: Callable[[Vec], float]) -> float:
+        """Beyond the paper: a sub-target that does not bring the robot nearer the goal
+        (measured like Delta L) costs ``dead_end_penalty`` more: a detour into a pocket
+        or back the way the robot came is the last resort, not a tie."""
+        here, there = to_goal(robot), to_goal(end)
+        if math.isinf(there) or there > here - self.p.cell / 2:
+            return self.p.dead_end_penalty
+        return 0.0
+
+    def _rejoin_point(self, point: Vec, statics: list[Obstacle]) -> Vec | None:
+        """The farthest point of the global path within the window that ``point`` sees
+        in a straight line clear of ``statics``; None if there is none."""
+        assert self.start is not None
+        p = self.p
+        axis = self.goal - self.start
+        length = float(np.hypot(*axis))
+        if length < 1e-9:
+            return None
+        unit = axis / length
+        s0 = float((point - self.start) @ unit)
+        lows, highs = self._boxes(statics)
+        need = p.robot_radius + p.safety_margin
+        for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
+            on_path = self.start + unit * max(float(s), 0.0)
+            leg = on_path - point
+            leg_length = float(np.hypot(*leg))
+            if leg_length > p.window_radius:
+                continue
+            if leg_length < 1e-9:
+                return on_path
+            samples = path_points(point, leg / leg_length, leg_length, p.cell / 4)
+            gaps = gap_to_boxes(samples, lows, highs)
+            if (gaps >= min(need, float(gaps[0]))).all():
+                return on_path
+        return None
+
+    def _boxes(self, statics: list[Obstacle]) -> tuple[Vec, Vec]:
+        corners = [cell_squares(o.cells, self.p.cell) for o in statics]
+        lows = np.array([c[0] for c in corners], dtype=np.float64).reshape(-1, 2)
+        highs = np.array([c[1] for c in corners], dtype=np.float64).reshape(-1, 2)
+        return lows, highs
+
+    def _statics(self, obstacles: list[Obstacle]) -> list[Obstacle]:
+        return [o for o in obstacles
+                if o.kind != "dynamic" or math.hypot(*o.velocity) < self.p.moving_speed]
 
     def _assess_all(
         self, robot: Vec, target: Vec, obstacles: list[Obstacle], extra_margin: float,
@@ -232,11 +315,8 @@ class Planner:
     def plan_detour(self, robot: Vec, threat: Assessment, obstacles: list[Obstacle],
                     fast: bool) -> Detour | None:
         p = self.p
-        statics = [o for o in obstacles if o.kind != "dynamic"
-                   or math.hypot(*o.velocity) < p.moving_speed]
-        corners = [cell_squares(o.cells, p.cell) for o in statics]
-        lows = np.array([c[0] for c in corners]).reshape(-1, 2)
-        highs = np.array([c[1] for c in corners]).reshape(-1, 2)
+        statics = self._statics(obstacles)
+        lows, highs = self._boxes(statics)
         movers = [Mover(np.asarray(o.position, dtype=np.float64),
                         np.asarray(o.velocity, dtype=np.float64), o.radius)
                   for o in obstacles if o not in statics]
@@ -254,7 +334,12 @@ class Planner:
         else:  # to the potential collision point, and past the mover's footprint
             centre = robot + axis * max(threat.robot_distance, p.cell)
             extra = clearance + threat.obstacle.radius
-        side = self.detour.side if self.detour is not None else 0
+        to_goal = self._to_goal(robot, lows, highs)
+        # Keep to the side already taken round this obstacle (or the detour under way):
+        # swinging from one side to the other between obstacles gets nowhere.
+        side = self.sides.get(threat.obstacle.id, 0)
+        if side == 0 and self.detour is not None:
+            side = self.detour.side
         choice = choose_detour(
             robot, centre, self.goal, self.global_cells, (lows, highs), movers,
             speed=p.max_speed if fast else p.cruise_speed, cell=p.cell,
@@ -262,11 +347,14 @@ class Planner:
             fan_step=math.radians(p.fan_step_deg), fan_max=math.radians(p.fan_max_deg),
             extra_length=extra if p.extend_past else 0.0, side=side,
             switch_penalty=p.switch_penalty,
+            end_cost=lambda end: self._way_on_cost(robot, end, to_goal),
+            to_goal=to_goal,
         )
         if choice.best is None:
             return None
-        return Detour(np.asarray(choice.best.end), threat.obstacle.id, threat.letter,
-                      1 if choice.best.g > 0 else -1)
+        chosen = 1 if choice.best.g > 0 else -1
+        self.sides[threat.obstacle.id] = chosen
+        return Detour(np.asarray(choice.best.end), threat.obstacle.id, threat.letter, chosen)
 
     # -- the cycle ---------------------------------------------------------------------
 
@@ -278,6 +366,7 @@ class Planner:
             self.first_seen.setdefault(ob.id, stamp)
         live = {ob.id for ob in obstacles}
         self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
+        self.sides = {i: side for i, side in self.sides.items() if i in live}
         robot = np.array(pose[:2], dtype=np.float64)
         if self.start is None:
             self.start = robot.copy()
@@ -289,7 +378,7 @@ class Planner:
 
         in_window = [o for o in obstacles
                      if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
-        path_target = self.path_target(robot)
+        path_target = self.path_target(robot, self._statics(in_window))
 
         if self.detour is not None:
             reached = float(np.hypot(*(self.detour.subtarget - robot))) < p.subtarget_reached

@@ -28,6 +28,7 @@ Where the paper leaves room, the choices here are:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,6 +129,8 @@ def choose_detour(
     extra_length: float = 0.0,
     side: int = 0,
     switch_penalty: float = 0.0,
+    end_cost: Callable[[Vec], float] | None = None,
+    to_goal: Callable[[Vec], float] | None = None,
 ) -> Choice:
     """Score the fan of straight candidates around the centreline robot -> centre_point.
 
@@ -135,7 +138,10 @@ def choose_detour(
     are checked in space and time with the robot at ``speed`` along each candidate.
     ``side`` (+1 left, -1 right, 0 none) is the side of a detour already under way;
     candidates on the other side cost ``switch_penalty`` more, so that a re-plan does
-    not swing the robot from one side of an obstacle to the other.
+    not swing the robot from one side of an obstacle to the other. ``end_cost`` adds a
+    cost for where a candidate ends (the caller's judgement of the way on from there).
+    ``to_goal`` measures Delta L (m, divided by the cell here); the paper's straight-line
+    distance to ``goal`` when not given.
     """
     offset = centre_point - robot
     length = float(np.hypot(*offset)) + extra_length
@@ -150,11 +156,13 @@ def choose_detour(
         times = np.linspace(0.0, length / speed if speed > 0 else math.inf, len(points))
         shared = len(cells_on_segment(robot, end, cell) & global_cells)
         w = 1.0 / (1 + shared)
-        delta_l = float(np.hypot(*(goal - end))) / cell
+        delta_l = (to_goal(end) if to_goal is not None else float(np.hypot(*(goal - end)))) / cell
         blocked = _blocked(points, times, boxes, movers, robot_radius, margin)
         cost = math.inf if blocked else morphin_cost(g, delta_l, w, kappa)
         if side and g * side < 0:
             cost += switch_penalty
+        if end_cost is not None and math.isfinite(cost):
+            cost += end_cost(end)
         candidates.append(Candidate(g, (float(end[0]), float(end[1])), cost, delta_l, w, shared))
     feasible = [c for c in candidates if math.isfinite(c.cost)]
     best = min(feasible, key=lambda c: (c.cost, abs(c.g), c.g)) if feasible else None

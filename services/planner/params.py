@@ -95,6 +95,14 @@ class Params(BaseModel):
         0.05, ge=0, description="on a detour, the margin may shrink by this much before the "
         "way to the sub-target counts as blocked and the detour is planned again, m"
     )
+    around_obstacles: bool = Field(
+        True, description="beyond the paper: Delta L is the distance to the goal around the "
+        "standing obstacles seen so far, not in a straight line (paper: False)"
+    )
+    dead_end_penalty: float = Field(
+        5.0, ge=0, description="beyond the paper: extra cost of a sub-target that leads back "
+        "or from which the global path cannot be seen again"
+    )
     subtarget_reached: float = Field(
         0.15, gt=0, description="a sub-target this close counts as reached, m"
     )

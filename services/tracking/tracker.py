@@ -272,9 +272,12 @@ class Tracker:
             if ti not in coast and was_static and t.kind == "static":
                 # A standing obstacle shows other faces as the robot drives round it: its
                 # grid area S_k is everything seen of it so far, not just this scan's part.
-                t.box = _union(t.box, m.box)
-                t.area = int(box_area(np.array(t.box)))
-                t.radius = max(t.radius, m.radius)
+                # Only a view with both ends free adds to it; a part cut off by something
+                # in front or by the window edge neither grows nor shrinks it.
+                if not m.partial:
+                    t.box = _union(t.box, m.box)
+                    t.area = int(box_area(np.array(t.box)))
+                    t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
             t.partial, t.n_parts = m.partial, m.n_parts
