@@ -44,10 +44,21 @@ SERVICE_MODULES: dict[str, str] = {
 }
 assert tuple(SERVICE_MODULES) == SERVICE_ORDER
 
+PLANNER_MODULES: dict[str, str] = {
+    "paper": "zenav.services.planner.node",
+}
+"""Planner implementations: each reads the same inputs and publishes the same outputs
+as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""
 
-def service_module(name: str) -> ModuleType:
+
+def service_module(name: str, planner: str = "paper") -> ModuleType:
     if name not in SERVICE_MODULES:
         raise ConfigError(f"no service named {name!r}; the services are {', '.join(SERVICE_ORDER)}")
+    if name == "planner":
+        if planner not in PLANNER_MODULES:
+            raise ConfigError(f"no planner named {planner!r}; the planners are "
+                              f"{', '.join(PLANNER_MODULES)}")
+        return importlib.import_module(PLANNER_MODULES[planner])
     return importlib.import_module(SERVICE_MODULES[name])
 
 
@@ -91,9 +102,9 @@ def setup_logging(level: str, name: str) -> None:
     )
 
 
-async def serve(name: str, bus: Bus, keys: Keys, params: Any) -> None:
+async def serve(name: str, bus: Bus, keys: Keys, params: Any, planner: str = "paper") -> None:
     """Build the service on ``bus`` and run it until stopped or until its run() ends."""
-    module = service_module(name)
+    module = service_module(name, planner)
     node = Node(name, bus, keys)
     service = module.Service(node, params)
     loop = asyncio.get_running_loop()
@@ -130,11 +141,15 @@ def main(name: str, argv: list[str] | None = None) -> int:
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override one parameter (dotted names for nested ones)")
     parser.add_argument("--log-level", default="INFO")
+    if name == "planner":
+        parser.add_argument("--planner", default="paper",
+                            help=f"implementation: {', '.join(PLANNER_MODULES)} (default paper)")
     add_transport_arguments(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
     try:
-        module = service_module(name)
+        planner = getattr(args, "planner", "paper")
+        module = service_module(name, planner)
         params = load_params(module.Params, args.config, args.set)
         keys = Keys(check_robot_id(args.robot_id))
         transport = transport_from_args(args, name)
@@ -145,7 +160,7 @@ def main(name: str, argv: list[str] | None = None) -> int:
     async def amain() -> None:
         bus = ZenohBus(transport, asyncio.get_running_loop())
         try:
-            await serve(name, bus, keys, params)
+            await serve(name, bus, keys, params, planner)
         finally:
             bus.close()
 

@@ -76,6 +76,7 @@ class Stack:
     base_port: int = field(default_factory=free_port_block)
     services: Iterable[str] = SERVICE_ORDER
     log_level: str = "INFO"
+    planner: str = "paper"
     processes: dict[str, subprocess.Popen[bytes]] = field(default_factory=dict)
 
     def command(self, service: str) -> list[str]:
@@ -86,6 +87,7 @@ class Stack:
             "--robot-id", self.robot_id,
             "--base-port", str(self.base_port),
             "--log-level", self.log_level,
+            *(["--planner", self.planner] if service == "planner" else []),
         ]
 
     def log_path(self, service: str) -> Path:

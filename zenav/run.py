@@ -21,11 +21,9 @@ from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
 from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
+from zenav.services.runner import PLANNER_MODULES
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import Scenario, load_scenario
-
-PLANNERS = ("paper",)
-"""Planner services ``--planner`` can pick."""
 
 
 class RunError(RuntimeError):
@@ -147,13 +145,13 @@ def run_scenario(
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
-    if planner not in PLANNERS:
-        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
+    if planner not in PLANNER_MODULES:
+        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNER_MODULES)}")
     params = stack_params(scenario, scenario_path, planner)
     for text in overrides or []:
         apply_override(params, text)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stack = Stack(out_dir=out_dir, params=params, log_level=log_level)
+    stack = Stack(out_dir=out_dir, params=params, log_level=log_level, planner=planner)
     started = time.monotonic()
     stack.start()
     try:
