@@ -48,6 +48,7 @@ OBSTACLES = Topic("obstacles", ObstacleChain)
 TRACKS = Topic("tracks", TrackList)
 CMD_VEL = Topic("cmd_vel", VelocityCommand)
 EVENTS = Topic("planner/events", PlannerEvent)
+EVENT_HISTORY = Topic("planner/history", PlannerEvent)  # queryable: every event so far
 PLANNER_STATE = Topic("planner/state", PlannerState)
 TRUTH = Topic("sim/truth", GroundTruth, max_bytes=256 * 1024)
 RESULT = Topic("sim/result", RunResult, max_bytes=16 * 1024 * 1024)

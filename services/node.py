@@ -49,11 +49,14 @@ class TypedPublisher(Generic[M]):
         self._seq += 1
         return seq
 
-    def publish(self, message: M) -> None:
+    def publish(self, message: M) -> bytes:
+        """Send ``message``; returns the payload sent."""
         if not isinstance(message, self.topic.message):
             raise TypeError(f"{self.topic.name} carries {self.topic.message.__name__}")
-        self._publisher.put(encode(message))
+        payload = encode(message)
+        self._publisher.put(payload)
         self.last = message
+        return payload
 
     def republish(self) -> None:
         """Send the last message again (answers a retransmitted input)."""

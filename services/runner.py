@@ -46,6 +46,9 @@ assert tuple(SERVICE_MODULES) == SERVICE_ORDER
 
 PLANNER_MODULES: dict[str, str] = {
     "paper": "zenav.services.planner.node",
+    "vfh": "zenav.services.baselines.vfh_node",
+    "dwa": "zenav.services.baselines.dwa_node",
+    "apf": "zenav.services.baselines.apf_node",
 }
 """Planner implementations: each reads the same inputs and publishes the same outputs
 as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""

@@ -29,6 +29,10 @@ log = logging.getLogger(__name__)
 LivelinessCallback = Callable[[str, bool], None]
 """Called on the asyncio loop with (token key, alive)."""
 
+Snapshot = Callable[[], list[bytes]]
+"""Answers a query with payloads. Called on a middleware thread: it must only read
+(copy) data, never touch the asyncio loop."""
+
 
 class TransportConfig(BaseModel):
     """How a process joins the Zenoh network.
@@ -139,6 +143,15 @@ class Bus(ABC):
         """Call ``callback`` for tokens already alive and every later appearance or loss."""
 
     @abstractmethod
+    def declare_queryable(self, key: str, snapshot: Snapshot) -> None:
+        """Answer every query on ``key`` with the payloads ``snapshot`` returns (history
+        a late joiner can still fetch, like a latched topic)."""
+
+    @abstractmethod
+    async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
+        """Every reply to a query on ``selector``, within ``timeout`` s."""
+
+    @abstractmethod
     def close(self) -> None: ...
 
 
@@ -179,6 +192,7 @@ class InMemoryBus(Bus):
         self._subs: list[Subscription] = []
         self._alive: set[str] = set()
         self._watchers: list[tuple[str, LivelinessCallback]] = []
+        self._queryables: list[tuple[str, Snapshot]] = []
         self.published: list[tuple[str, bytes]] = []
 
     def deliver(self, key: str, payload: bytes) -> None:
@@ -214,6 +228,13 @@ class InMemoryBus(Bus):
         for key in sorted(self._alive):
             if key_matches(key_expr, key):
                 callback(key, True)
+
+    def declare_queryable(self, key: str, snapshot: Snapshot) -> None:
+        self._queryables.append((key, snapshot))
+
+    async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
+        return [(key, payload) for key, snapshot in self._queryables
+                if key_matches(selector, key) for payload in snapshot()]
 
     def close(self) -> None:
         for sub in list(self._subs):
@@ -293,6 +314,27 @@ class ZenohBus(Bus):
 
         handle = self._session.liveliness().declare_subscriber(key_expr, on_sample, history=True)
         self._declared.append(handle)
+
+    def declare_queryable(self, key: str, snapshot: Snapshot) -> None:
+        def on_query(query: Any) -> None:
+            try:
+                with query:  # always finished, or the asker waits for its whole timeout
+                    for payload in snapshot():
+                        query.reply(key, payload)
+            except Exception:  # never let an exception reach Zenoh's thread
+                log.exception("answering a query on %s failed", key)
+
+        self._declared.append(self._session.declare_queryable(key, on_query))
+
+    async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
+        def ask() -> list[tuple[str, bytes]]:
+            replies = []
+            for reply in self._session.get(selector, timeout=timeout):
+                if reply.ok is not None:
+                    replies.append((str(reply.ok.key_expr), reply.ok.payload.to_bytes()))
+            return replies
+
+        return await asyncio.to_thread(ask)
 
     def close(self) -> None:
         for handle in reversed(self._declared):

@@ -25,7 +25,7 @@ from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
 from zenav.services.planner.decide import Decision, Planner
-from zenav.services.planner.node import EventLog, obstacles_of
+from zenav.services.planner.node import EventLog, EventRow, obstacles_of
 from zenav.services.planner.params import Params as PlannerParams
 from zenav.services.tracking.node import track_message
 from zenav.services.tracking.params import TrackingParams
@@ -45,7 +45,7 @@ class Cycle:
     clusters: Clusters
     tracks: list[Track]
     decision: Decision
-    events: list[tuple[str, str, int | None, str | None, str]]
+    events: list[EventRow]
 
 
 @dataclass

@@ -122,13 +122,21 @@ async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, li
                 where = "before the first tick" if sim_time < 0 else f"at t={sim_time:.2f} s"
                 raise RunError(f"the simulation made no progress for {progress_timeout:.0f} s "
                                 f"{where}; see the logs in {stack.out_dir / 'logs'}")
-        await asyncio.sleep(0.3)  # let the last events in flight arrive
+        # The planner keeps every event it made; asking for them all does not depend on
+        # this process having been subscribed before the first one.
+        history = await bus.query(k.of(keys.EVENT_HISTORY), timeout=5.0)
+        payloads = [payload for _, payload in history]
         while events_sub.pending():
-            _, payload = await events_sub.get()
+            payloads.append((await events_sub.get())[1])
+        seen: set[int] = set()
+        for payload in payloads:
             try:
-                events.append(decode(payload, PlannerEvent, k.of(keys.EVENTS)))
+                event = decode(payload, PlannerEvent, k.of(keys.EVENTS))
             except DecodeError:
                 continue
+            if event.seq not in seen:
+                seen.add(event.seq)
+                events.append(event)
         token.undeclare()
         return result, events
     finally:

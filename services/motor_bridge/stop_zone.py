@@ -42,5 +42,6 @@ def zone_blocked(
     hit = r < range_max
     x = r * np.cos(angles)
     y = r * np.sin(angles)
-    inside = hit & (x > 0.0) & (x <= robot_radius + ahead) & (np.abs(y) <= robot_radius + side_margin)
+    half_width = robot_radius + side_margin
+    inside = hit & (x > 0.0) & (x <= robot_radius + ahead) & (np.abs(y) <= half_width)
     return bool(inside.any())

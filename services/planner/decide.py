@@ -23,7 +23,6 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import cast
 
 import numpy as np
 import numpy.typing as npt
@@ -64,13 +63,14 @@ class Commitment:
 
     letter: ScenarioLetter
     action: Action
+    last: Assessment | None = None  # how the obstacle was last judged a threat
 
 
 @dataclass
 class Detour:
     subtarget: Vec
     obstacle: int
-    letter: str
+    letter: ScenarioLetter
     side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
 
 
@@ -294,6 +294,20 @@ class Planner:
                 first, who = t, ob
         return first, who
 
+    def _crossed(self, robot: Vec, target: Vec, ob: Obstacle) -> bool:
+        """Whether a crosser has got across the line the robot is driving along (it is
+        on the far side of it, moving away, clear by the clearance)."""
+        offset = target - robot
+        length = float(np.hypot(*offset))
+        if length < 1e-9:
+            return True
+        d = offset / length
+        rel = np.asarray(ob.position) - robot
+        side = float(d[0] * rel[1] - d[1] * rel[0])
+        away = float(d[0] * ob.velocity[1] - d[1] * ob.velocity[0])
+        clearance = self.p.robot_radius + ob.radius + self.p.safety_margin
+        return side * away > 0 and abs(side) > clearance
+
     def _unconfirmed(self, a: Assessment, stamp: float) -> bool:
         """A standing obstacle seen for less than ``confirm_time`` may yet turn out to move
         (slow movers need a while to show it); while it is farther ahead than
@@ -340,21 +354,28 @@ class Planner:
         side = self.sides.get(threat.obstacle.id, 0)
         if side == 0 and self.detour is not None:
             side = self.detour.side
-        choice = choose_detour(
-            robot, centre, self.goal, self.global_cells, (lows, highs), movers,
-            speed=p.max_speed if fast else p.cruise_speed, cell=p.cell,
-            robot_radius=p.robot_radius, margin=p.safety_margin, kappa=p.kappa,
-            fan_step=math.radians(p.fan_step_deg), fan_max=math.radians(p.fan_max_deg),
-            extra_length=extra if p.extend_past else 0.0, side=side,
-            switch_penalty=p.switch_penalty,
-            end_cost=lambda end: self._way_on_cost(robot, end, to_goal),
-            to_goal=to_goal,
-        )
-        if choice.best is None:
+        best = None
+        # The paper's fan first; if it is blocked all round (the robot is in a pocket),
+        # a fan that also turns back, so the robot can leave the way it came.
+        for fan_max in (p.fan_max_deg, p.escape_fan_deg):
+            choice = choose_detour(
+                robot, centre, self.goal, self.global_cells, (lows, highs), movers,
+                speed=p.max_speed if fast else p.cruise_speed, cell=p.cell,
+                robot_radius=p.robot_radius, margin=p.safety_margin, kappa=p.kappa,
+                fan_step=math.radians(p.fan_step_deg), fan_max=math.radians(fan_max),
+                extra_length=extra if p.extend_past else 0.0, side=side,
+                switch_penalty=p.switch_penalty,
+                end_cost=lambda end: self._way_on_cost(robot, end, to_goal),
+                to_goal=to_goal,
+            )
+            best = choice.best
+            if best is not None:
+                break
+        if best is None:
             return None
-        chosen = 1 if choice.best.g > 0 else -1
+        chosen = 1 if best.g > 0 else -1
         self.sides[threat.obstacle.id] = chosen
-        return Detour(np.asarray(choice.best.end), threat.obstacle.id, threat.letter, chosen)
+        return Detour(np.asarray(best.end), threat.obstacle.id, threat.letter, chosen)
 
     # -- the cycle ---------------------------------------------------------------------
 
@@ -396,10 +417,24 @@ class Planner:
         # its type is known (the motor bridge's stop zone covers the meantime).
         threats = [self._sticky(a) for a in notes
                    if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)]
+        # A crosser the robot gives way to stays answered until it has crossed the
+        # robot's way, not only while the prediction (noisy) still says they would meet.
+        found = {a.obstacle.id: a for a in notes}
+        by_id = {o.id: o for o in in_window}
+        for ob_id, held in self.commitments.items():
+            ob = by_id.get(ob_id)
+            if (held.letter != "e" or held.last is None or ob is None
+                    or any(a.obstacle.id == ob_id for a in threats)
+                    or self._crossed(robot, target, ob)):
+                continue
+            seen = found.get(ob_id)
+            base = seen if seen is not None else dataclasses.replace(held.last, obstacle=ob)
+            threats.append(dataclasses.replace(base, letter="e", threat=True))
         threat_ids = {a.obstacle.id for a in threats}
         self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}
 
-        speed, action = p.cruise_speed, cast(Action, "keep")
+        speed = p.cruise_speed
+        action: Action = "keep"
         lead: Assessment | None = None
         needs_detour = [a for a in threats if a.letter in "bf"]
         if needs_detour:
@@ -430,7 +465,7 @@ class Planner:
                 act, v = self.crossing_response(a, committed.action if committed else None)
             else:
                 act, v = self.follow_response(a)
-            self.commitments[a.obstacle.id] = Commitment(a.letter, act)
+            self.commitments[a.obstacle.id] = Commitment(a.letter, act, a)
             responses.append((v, act, a))
         if responses:
             v, act, slowest = min(responses, key=lambda r: r[0])
@@ -471,6 +506,7 @@ class Planner:
             letter = self.detour.letter
         else:
             letter = "a"
+
 
         tx, ty = float(target[0]), float(target[1])
         v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,

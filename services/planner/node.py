@@ -4,6 +4,8 @@ and the planner's state for monitors."""
 
 from __future__ import annotations
 
+from collections import deque
+
 from zenav.schemas import keys
 from zenav.schemas.messages import (
     Action,
@@ -30,6 +32,9 @@ def obstacles_of(tracks: TrackList) -> list[Obstacle]:
 
 
 EventRow = tuple[ScenarioLetter, Action, int | None, ObstacleKind | None, str]
+
+EVENTS_KEPT = 10_000
+"""Events the planner keeps for queries: far more than a run makes, still bounded."""
 
 RESUME_AFTER = 3
 """Cycles without any threat before a return to plain driving is reported."""
@@ -81,6 +86,9 @@ class Service:
         self.log = EventLog(params.horizon)
         self.commands = node.publisher(keys.CMD_VEL, VelocityCommand, urgent=True)
         self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
+        # Every event so far, for whoever asks (a run that joined late, a monitor).
+        self.history: deque[bytes] = deque(maxlen=EVENTS_KEPT)
+        node.bus.declare_queryable(node.keys.of(keys.EVENT_HISTORY), lambda: list(self.history))
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
         self.gate = StampGate()
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
@@ -98,9 +106,9 @@ class Service:
         decision = self.planner.step((pose.x, pose.y, pose.heading), obstacles_of(tracks),
                                      tracks.stamp)
         for letter, action, obstacle, kind, detail in self.log.events(decision):
-            self.events.publish(PlannerEvent(
+            self.history.append(self.events.publish(PlannerEvent(
                 stamp=tracks.stamp, seq=self.events.next_seq(), obstacle=obstacle,
-                kind=kind, scenario=letter, action=action, detail=detail))
+                kind=kind, scenario=letter, action=action, detail=detail)))
         self.commands.publish(VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(),
                                               v=decision.v, omega=decision.omega))
         self.state.publish(PlannerState(

@@ -83,6 +83,10 @@ class Params(BaseModel):
     )
     fan_step_deg: float = Field(5.0, gt=0, description="angle between candidate paths, deg")
     fan_max_deg: float = Field(85.0, gt=0, lt=90, description="widest candidate, deg")
+    escape_fan_deg: float = Field(
+        175.0, gt=0, lt=180, description="beyond the paper: widest candidate when the "
+        "paper's fan is blocked all round, deg"
+    )
     extend_past: bool = Field(
         True, description="beyond the paper: lengthen candidates by the clearance so the "
         "sub-target lies past the obstacle instead of beside it (paper: False)"

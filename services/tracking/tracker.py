@@ -576,21 +576,22 @@ class Tracker:
         """Type from the free-space motion cue when perception measures it, else from the
         filtered speed alone; with hysteresis; "new" for the first frames.
 
-        With the cue, a track is dynamic while the cue fired within ``moved_hold`` s, or
-        when the filter is sure of a speed above ``dynamic_speed`` (a fast mover just come
-        into view has no earlier scan to be compared with yet). The filtered speed alone
-        cannot tell a slow walker from the drift of a box's visible part as the robot
-        drives past; the cue can."""
+        With the cue, a track is dynamic while the cue fired within ``moved_hold`` s. The
+        filtered speed alone cannot tell a slow walker from the drift of a box's visible
+        part as the robot drives past (at 0.5 m/s that drift exceeds 0.2 m/s); the cue
+        can. A fast mover just come into view is caught by the cue's 0.5 s baseline."""
         p = self.params
         if t.age <= p.new_frames:
             return "new"
         speed = math.hypot(t.vx, t.vy)
         if cue:
+            # The cue decides; the filtered speed only keeps a mover dynamic while it is
+            # briefly out of the cue's sight (passing beside the robot, say).
             moving = t.last_moved is not None and stamp - t.last_moved <= p.moved_hold
-            significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))
-            fast = speed > p.dynamic_speed and significant
-            still_going = t.kind == "dynamic" and speed >= p.static_speed
-            return "dynamic" if moving or fast or still_going else "static"
+            still_going = (t.kind == "dynamic" and speed >= p.static_speed
+                           and t.last_moved is not None
+                           and stamp - t.last_moved <= p.moved_hold + p.drop_after)
+            return "dynamic" if moving or still_going else "static"
         if t.kind == "dynamic":
             return "dynamic" if speed >= p.static_speed else "static"
         significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))

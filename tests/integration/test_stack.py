@@ -11,6 +11,7 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import psutil
 import pytest
@@ -41,7 +42,7 @@ def write_scenario(path: Path, **changes: object) -> Path:
     return path
 
 
-def check_record(record: dict, scenario: dict) -> None:
+def check_record(record: dict[str, Any], scenario: dict[str, Any]) -> None:
     """The run record as the spec promises it, recomputed from the trajectory."""
     assert set(record) >= {"scenario", "planner", "outcome", "time", "path_length",
                            "min_clearance", "trajectory", "events"}

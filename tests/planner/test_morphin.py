@@ -73,12 +73,15 @@ def test_the_centreline_through_an_obstacle_is_infinitely_expensive():
 def test_a_detour_under_way_keeps_its_side():
     robot, goal = np.array([0.0, 0.0]), np.array([10.0, 0.0])
     box = (np.array([[2.75, -0.25]]), np.array([[3.25, 0.25]]))
-    kwargs = dict(speed=0.1, cell=0.5, robot_radius=0.2, margin=0.1, kappa=KAPPA,
-                  fan_step=math.radians(5), fan_max=math.radians(85), extra_length=0.8,
-                  switch_penalty=10.0)
     cells = cells_on_segment(robot, goal, 0.5)
-    left = choose_detour(robot, np.array([3.0, 0.0]), goal, cells, box, [], side=1, **kwargs)
-    right = choose_detour(robot, np.array([3.0, 0.0]), goal, cells, box, [], side=-1, **kwargs)
+
+    def choose(side: int):
+        return choose_detour(robot, np.array([3.0, 0.0]), goal, cells, box, [], speed=0.1,
+                             cell=0.5, robot_radius=0.2, margin=0.1, kappa=KAPPA,
+                             fan_step=math.radians(5), fan_max=math.radians(85),
+                             extra_length=0.8, side=side, switch_penalty=10.0)
+
+    left, right = choose(1), choose(-1)
     assert left.best is not None and right.best is not None
     assert left.best.g > 0 > right.best.g
 

@@ -1,0 +1,95 @@
+"""What the three baseline planners share: the mission parameters, what one planning
+cycle sees, and small geometry helpers (pure, no I/O).
+
+A cycle sees the laser scan in the robot frame (ranges and beam angles relative to the
+heading), the robot pose at scan time and its velocity, the goal, and the tracked
+obstacles (positions, velocities, radii; only DWA uses their velocities).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+from pydantic import BaseModel, ConfigDict, Field
+
+FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+
+
+class MissionParams(BaseModel):
+    """The mission fields ``zenav run`` hands every planner (see ``zenav.run.stack_params``).
+
+    ``start`` and ``cell`` are accepted so that any planner runs under the same
+    parameters; the baselines do not use them (they have no global path and keep their
+    own grids).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    goal: tuple[float, float] = Field((6.0, 0.0), description="global target, m")
+    start: tuple[float, float] | None = Field(
+        None, description="start of the global path, m (accepted, unused by the baselines)"
+    )
+    goal_tolerance: float = Field(0.25, gt=0, description="arrived within this distance, m")
+    cruise_speed: float = Field(0.1, gt=0, description="V_R: top speed the planner asks for, m/s")
+    max_speed: float = Field(0.2, gt=0, description="top speed of the base, m/s")
+    robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
+    cell: float = Field(0.5, gt=0, description="the paper's grid r, m (accepted, unused)")
+    window_radius: float = Field(4.0, gt=0, description="returns farther than this are "
+                                 "ignored, m")
+    max_omega: float = Field(1.0, gt=0, description="turn rate limit, rad/s (as the paper "
+                             "planner's)")
+    moving_speed: float = Field(0.03, ge=0, description="tracks slower than this count as "
+                                "standing still, m/s")
+
+
+@dataclass(frozen=True)
+class Obstacles:
+    """Tracked obstacles in the world frame: (n, 2) positions and velocities, (n,) radii."""
+
+    positions: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    velocities: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    radii: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+    def __len__(self) -> int:
+        return int(self.radii.size)
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """Everything one planning cycle sees."""
+
+    ranges: FloatArray  # m, one per beam
+    angles: FloatArray  # rad, beam directions relative to the heading
+    range_max: float  # m: a range this long is no return
+    pose: tuple[float, float, float]  # x m, y m, heading rad (at scan time)
+    velocity: tuple[float, float]  # v m/s, omega rad/s
+    goal: tuple[float, float]  # m
+    movers: Obstacles = field(default_factory=Obstacles)  # tracks that move
+
+
+def wrap(angle: float) -> float:
+    """Angle in [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def returns(cycle: Cycle, reach: float) -> BoolArray:
+    """Beams with a return within ``reach`` m."""
+    return (cycle.ranges < cycle.range_max * 0.999) & (cycle.ranges <= reach)
+
+
+def world_points(cycle: Cycle, mask: BoolArray) -> FloatArray:
+    """The (n, 2) world points of the beams in ``mask``."""
+    x, y, heading = cycle.pose
+    r = cycle.ranges[mask]
+    a = cycle.angles[mask] + heading
+    return np.column_stack((x + r * np.cos(a), y + r * np.sin(a)))
+
+
+def goal_reached(cycle: Cycle, tolerance: float) -> bool:
+    """Within half the goal tolerance: stop (the simulator ends the run at the tolerance)."""
+    x, y, _ = cycle.pose
+    return math.hypot(cycle.goal[0] - x, cycle.goal[1] - y) <= tolerance / 2

@@ -1,0 +1,171 @@
+"""Dynamic Window Approach (DWA), the classic ROS local planner (pure, no I/O).
+
+D. Fox, W. Burgard and S. Thrun, "The Dynamic Window Approach to Collision Avoidance",
+IEEE Robotics & Automation Magazine 4(1), 23–33, 1997.
+
+Each cycle searches the space of (v, ω) for circular arcs:
+
+1. **Dynamic window**: the velocities reachable within one control period from the
+   current ones, ``[v − v̇ Δt, v + v̇ Δt] × [ω − ω̇ Δt, ω + ω̇ Δt]``, cut to the robot's
+   limits, sampled ``vx_samples`` × ``vth_samples`` (ROS ``dwa_local_planner`` samples 3
+   × 20; more here, as the window is small at 10 Hz).
+2. **Forward simulation** of each arc for ``sim_time`` s in steps of
+   ``sim_granularity`` s (ROS: 1.7 s, 0.025 m; the paper: the arc itself), against the
+   scan's returns and the tracked movers at their predicted positions (the tracks'
+   velocities, so that DWA has the same knowledge of movers as the paper's planner;
+   scan returns on a mover are replaced by its prediction).
+3. **Admissible velocities**: ``v ≤ sqrt(2 · dist(v, ω) · v̇_b)``, the robot can stop
+   before the first contact on the arc.
+4. **Objective** ``G = α · heading + β · dist + γ · velocity``, each term in [0, 1]:
+   ``heading = 1 − |θ_goal − θ| / π`` at the end of the simulated arc (the paper scores
+   the pose after one period; implementations, like ROS's goal/path costs, score the end
+   of the rollout), ``dist`` the arc length to the first contact over ``dist_cap`` (the
+   paper's "large constant" when nothing is on the arc), ``velocity = v / v_max``. The
+   weights are the paper's, α = 2, β = 0.2, γ = 0.2: heading dominates and obstacles
+   act through admissibility and the distance term. The paper's smoothing of G over the
+   window is left out.
+
+``v_max`` is the mission's cruise speed, as every planner here is asked to cruise at it;
+the acceleration limits are the motor bridge's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from pydantic import Field
+from scipy.spatial import cKDTree
+
+from zenav.services.baselines.common import (
+    Cycle,
+    FloatArray,
+    MissionParams,
+    returns,
+    world_points,
+)
+
+
+class Params(MissionParams):
+    max_vel_x: float | None = Field(None, gt=0, description="top forward speed, m/s "
+                                    "(default: the cruise speed)")
+    min_vel_x: float = Field(0.0, ge=0, description="lowest forward speed, m/s (no reverse)")
+    max_vel_theta: float = Field(1.0, gt=0, description="turn rate limit, rad/s (ROS: 1.0)")
+    acc_lim_x: float = Field(0.5, gt=0, description="v̇: forward acceleration, m/s² "
+                             "(the motor bridge's)")
+    decel_lim_x: float = Field(1.0, gt=0, description="v̇_b: braking deceleration for "
+                               "admissibility, m/s² (the motor bridge's)")
+    acc_lim_theta: float = Field(3.2, gt=0, description="ω̇: turn acceleration, rad/s² "
+                                 "(ROS: 3.2)")
+    control_period: float = Field(0.1, gt=0, description="Δt: one scan period, s")
+    sim_time: float = Field(2.0, gt=0, description="forward simulation horizon, s")
+    sim_granularity: float = Field(0.1, gt=0, description="forward simulation step, s")
+    vx_samples: int = Field(7, ge=1, description="forward speed samples in the window")
+    vth_samples: int = Field(21, ge=1, description="turn rate samples in the window")
+    alpha: float = Field(2.0, ge=0, description="weight of heading")
+    beta: float = Field(0.2, ge=0, description="weight of dist (clearance on the arc)")
+    gamma: float = Field(0.2, ge=0, description="weight of velocity")
+    dist_cap: float = Field(2.0, gt=0, description="dist of an arc with nothing on it, m")
+    safety_margin: float = Field(0.05, ge=0, description="gap kept between footprints on "
+                                 "top of the radii, m")
+    mover_clearance: float = Field(0.15, ge=0, description="scan returns this close to a "
+                                   "mover's surface are the mover's, m")
+
+    @property
+    def v_max(self) -> float:
+        return self.max_vel_x if self.max_vel_x is not None else self.cruise_speed
+
+
+@dataclass(frozen=True)
+class Decision:
+    v: float
+    omega: float
+    admissible: int  # how many sampled arcs were admissible
+    score: float
+
+
+def rollout(x: float, y: float, heading: float, v: FloatArray, omega: FloatArray,
+            times: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Poses along the arcs (v_i, ω_i) at ``times``: x, y, heading of shape (n, k)."""
+    v, w, t = v[:, None], omega[:, None], times[None, :]
+    theta = heading + w * t
+    straight = np.abs(w) < 1e-6
+    safe_w = np.where(straight, 1.0, w)
+    px = np.where(straight, x + v * t * math.cos(heading),
+                  x + v / safe_w * (np.sin(theta) - math.sin(heading)))
+    py = np.where(straight, y + v * t * math.sin(heading),
+                  y - v / safe_w * (np.cos(theta) - math.cos(heading)))
+    return px, py, theta
+
+
+def plan(cycle: Cycle, p: Params) -> Decision:
+    x, y, heading = cycle.pose
+    v0, w0 = cycle.velocity
+    dt = p.control_period
+    v_hi = min(p.v_max, v0 + p.acc_lim_x * dt)
+    v_lo = min(max(p.min_vel_x, v0 - p.acc_lim_x * dt), v_hi)
+    w_hi = min(p.max_vel_theta, w0 + p.acc_lim_theta * dt)
+    w_lo = min(max(-p.max_vel_theta, w0 - p.acc_lim_theta * dt), w_hi)
+    vs = np.linspace(v_lo, v_hi, p.vx_samples)
+    ws = np.linspace(w_lo, w_hi, p.vth_samples)
+    if w_lo < 0.0 < w_hi:
+        ws = np.union1d(ws, [0.0])  # straight on is always a candidate
+    v, w = (a.ravel() for a in np.meshgrid(vs, ws, indexing="ij"))
+    steps = max(1, math.ceil(p.sim_time / p.sim_granularity - 1e-9))
+    times = p.sim_granularity * np.arange(1, steps + 1, dtype=np.float64)
+    px, py, theta = rollout(x, y, heading, v, w, times)
+
+    # Contact on each arc: against the scan's returns, and the movers where they will be.
+    collide = np.zeros(px.shape, dtype=bool)
+    reach = p.v_max * p.sim_time + p.robot_radius + p.safety_margin + 0.5
+    points = world_points(cycle, returns(cycle, min(reach, p.window_radius)))
+    movers = cycle.movers
+    if len(movers) and len(points):
+        gap = np.hypot(points[:, None, 0] - movers.positions[None, :, 0],
+                       points[:, None, 1] - movers.positions[None, :, 1])
+        points = points[(gap > movers.radii[None, :] + p.mover_clearance).all(axis=1)]
+    if len(points):
+        tree = cKDTree(points)
+        bound = p.robot_radius + p.safety_margin
+        d, _ = tree.query(np.column_stack((px.ravel(), py.ravel())), k=1,
+                          distance_upper_bound=bound)
+        collide |= (d < bound).reshape(px.shape)
+    for position, velocity, radius in zip(movers.positions, movers.velocities, movers.radii,
+                                          strict=True):
+        mx = position[0] + velocity[0] * times
+        my = position[1] + velocity[1] * times
+        collide |= np.hypot(px - mx[None, :], py - my[None, :]) < (
+            p.robot_radius + radius + p.safety_margin)
+    first = np.where(collide.any(axis=1), collide.argmax(axis=1), -1)
+    # Arc length to the last pose before contact; the "large constant" if none.
+    safe_time = np.where(first >= 0, first * p.sim_granularity, np.inf)
+    dist = np.where(first >= 0, v * safe_time, p.dist_cap)
+    admissible = v <= np.sqrt(2.0 * np.maximum(dist, 0.0) * p.decel_lim_x) + 1e-9
+
+    gx, gy = cycle.goal
+    end_x, end_y, end_theta = px[:, -1], py[:, -1], theta[:, -1]
+    error = np.abs((np.arctan2(gy - end_y, gx - end_x) - end_theta + math.pi)
+                   % (2 * math.pi) - math.pi)
+    score = (p.alpha * (1.0 - error / math.pi)
+             + p.beta * np.minimum(dist, p.dist_cap) / p.dist_cap
+             + p.gamma * v / p.v_max)
+    if not admissible.any():  # nothing lets it stop in time: brake hardest, most clearance
+        pick = int(np.lexsort((-dist, v))[0])
+        return Decision(float(v[pick]), float(w[pick]), 0, float(score[pick]))
+    pick = int(np.argmax(np.where(admissible, score, -np.inf)))
+    return Decision(float(v[pick]), float(w[pick]), int(admissible.sum()), float(score[pick]))
+
+
+class DWA:
+    """Stateless apart from its parameters: one window search per scan."""
+
+    def __init__(self, params: Params) -> None:
+        self.p = params
+
+    def step(self, cycle: Cycle) -> Decision:
+        decision = plan(cycle, self.p)
+        x, y, _ = cycle.pose
+        distance = math.hypot(cycle.goal[0] - x, cycle.goal[1] - y)
+        return Decision(min(decision.v, distance), decision.omega, decision.admissible,
+                        decision.score)

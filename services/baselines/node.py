@@ -1,0 +1,139 @@
+"""The planner node every baseline shares: the same inputs and outputs as the paper's
+planner, so a baseline runs as the ``planner`` service (``--planner vfh|dwa|apf``).
+
+It answers each track list with one velocity command stamped with the tracks' stamp
+(lockstep depends on it) and answers a repeated stamp by repeating its command. The
+scan that goes with a track list (same stamp; it arrives first, straight from the laser
+driver) and the odometry of that instant are kept by stamp. Tracks give the robot pose
+at scan time and the movers. The planner state says ``a`` (no paper scenario) and the
+action: ``keep`` when moving, ``stop`` when standing, ``goal`` at the goal; an event is
+published when the action changes.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from zenav.schemas import keys
+from zenav.schemas.messages import (
+    Action,
+    LaserScan,
+    Odometry,
+    PlannerEvent,
+    PlannerState,
+    TrackList,
+    VelocityCommand,
+)
+from zenav.services.baselines.common import Cycle, MissionParams, Obstacles, goal_reached
+from zenav.services.node import Node, StampGate
+
+KEPT = 8
+"""Scans and odometry messages kept by stamp."""
+
+STANDING = 0.005
+"""Commanded speeds below this, m/s, count as a stop."""
+
+
+class Command(Protocol):
+    @property
+    def v(self) -> float: ...
+
+    @property
+    def omega(self) -> float: ...
+
+
+class Policy(Protocol):
+    def step(self, cycle: Cycle) -> Command: ...
+
+
+def movers_of(tracks: TrackList, moving_speed: float) -> Obstacles:
+    moving = [t for t in tracks.tracks if t.kind == "dynamic" and t.speed >= moving_speed]
+    return Obstacles(
+        positions=np.array([[t.x, t.y] for t in moving], dtype=np.float64).reshape(-1, 2),
+        velocities=np.array([[t.vx, t.vy] for t in moving], dtype=np.float64).reshape(-1, 2),
+        radii=np.array([t.radius for t in moving], dtype=np.float64),
+    )
+
+
+def latest_at(kept: dict[float, LaserScan] | dict[float, Odometry], stamp: float) -> float | None:
+    """The stamp of the kept message for ``stamp``: the same, else the newest before it."""
+    if stamp in kept:
+        return stamp
+    earlier = [s for s in kept if s <= stamp]
+    return max(earlier) if earlier else None
+
+
+class BaselineService:
+    def __init__(self, node: Node, params: MissionParams, policy: Policy) -> None:
+        self.node = node
+        self.params = params
+        self.policy = policy
+        self.commands = node.publisher(keys.CMD_VEL, VelocityCommand, urgent=True)
+        self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
+        self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
+        self.gate = StampGate()
+        self.scans: dict[float, LaserScan] = {}
+        self.odometry: dict[float, Odometry] = {}
+        self.last_action: Action | None = None
+        self.last_command = (0.0, 0.0)
+        node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=4)
+        node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=8)
+        node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
+
+    def on_scan(self, scan: LaserScan) -> None:
+        self.scans[scan.stamp] = scan
+        while len(self.scans) > KEPT:
+            del self.scans[min(self.scans)]
+
+    def on_odometry(self, odometry: Odometry) -> None:
+        self.odometry[odometry.stamp] = odometry
+        while len(self.odometry) > KEPT:
+            del self.odometry[min(self.odometry)]
+
+    def cycle(self, tracks: TrackList, scan: LaserScan) -> Cycle:
+        p = self.params
+        at = latest_at(self.odometry, tracks.stamp)
+        velocity = self.last_command
+        if at is not None:
+            velocity = (self.odometry[at].v, self.odometry[at].omega)
+        pose = tracks.pose
+        return Cycle(ranges=scan.ranges.astype(np.float64), angles=scan.angles(),
+                     range_max=scan.range_max, pose=(pose.x, pose.y, pose.heading),
+                     velocity=velocity, goal=p.goal,
+                     movers=movers_of(tracks, p.moving_speed))
+
+    def on_tracks(self, tracks: TrackList) -> None:
+        order = self.gate.check(tracks.stamp)
+        if order == "repeat":
+            self.commands.republish()
+            return
+        if order == "old":
+            self.node.reject(self.node.keys.of(keys.TRACKS), "out_of_order",
+                             f"tracks stamped {tracks.stamp} after {self.gate.last}")
+            return
+        at = latest_at(self.scans, tracks.stamp)
+        v = omega = 0.0
+        action: Action = "stop"
+        detail = "no scan yet"
+        if at is not None:
+            cycle = self.cycle(tracks, self.scans[at])
+            if goal_reached(cycle, self.params.goal_tolerance):
+                action, detail = "goal", "at the goal"
+            else:
+                decision = self.policy.step(cycle)
+                v, omega = decision.v, decision.omega
+                action = "keep" if v >= STANDING else "stop"
+                detail = f"v {v:.2f} m/s, omega {omega:.2f} rad/s"
+        self.last_command = (v, omega)
+        if action != self.last_action:
+            self.last_action = action
+            self.events.publish(PlannerEvent(
+                stamp=tracks.stamp, seq=self.events.next_seq(), scenario="a", action=action,
+                detail=detail))
+        self.commands.publish(VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(),
+                                              v=v, omega=omega))
+        self.state.publish(PlannerState(
+            stamp=tracks.stamp, seq=self.state.next_seq(), scenario="a", action=action,
+            target=self.params.goal, speed=max(v, 0.0)))

@@ -1,0 +1,288 @@
+"""Vector Field Histogram (VFH), the method the paper builds on (pure, no I/O).
+
+J. Borenstein and Y. Koren, "The Vector Field Histogram — Fast Obstacle Avoidance for
+Mobile Robots", IEEE Transactions on Robotics and Automation 7(3), 278–288, 1991.
+
+Three stages, as in the paper:
+
+1. **Histogram grid** (world frame, ``grid_cell`` = 10 cm cells) built by histogramic
+   in-motion mapping (HIMM): each laser return adds ``increment`` (3) to the certainty
+   of its cell, each cell a beam passes through loses ``decrement`` (1); certainties stay
+   within [0, ``certainty_max``] (15). The grid remembers what left the 180° field of
+   view, as the paper's grid remembers what the sonars saw.
+2. **Polar histogram** over the active window (``window_cells`` × ``window_cells``
+   = 33 × 33 cells round the robot): each active cell adds ``m = c² (a − b d)`` to the
+   sector (``sector_deg`` = 5°, 72 sectors) its direction falls in, with
+   ``a − b d_max = 0`` (``d_max`` the window's half diagonal), then the histogram is
+   smoothed with the paper's triangular window of half-width ``smoothing`` (l = 5).
+3. **Valley selection**: sectors below ``threshold`` are free; the valley nearest to the
+   target direction is chosen. In a wide valley (more than ``s_max`` = 18 sectors) the
+   robot steers ``s_max / 2`` sectors inside the border nearest the target (k_n and
+   k_f = k_n ± s_max, θ = (k_n + k_f) / 2), or straight at the target when it lies in
+   the valley that far from both borders; in a narrow valley it steers down the middle.
+
+Speed, as in the paper: ``V' = V_max (1 − min(h_c, h_m) / h_m)`` with ``h_c`` the
+smoothed density in the current direction of travel, then
+``V = V' (1 − |Ω| / Ω_max) + V_min``; the turn rate ``Ω`` is proportional to the
+steering error. ``V_max`` is the mission's cruise speed.
+
+Moving obstacles are what the scan sees of them, as in the original: VFH has no notion
+of motion. With no free valley at all the robot stops and turns toward the emptiest
+sector. ``threshold`` and ``h_m`` are, as in the paper, empirical; the values here were
+chosen for a 0.2 m robot among 0.3–0.8 m obstacles.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from pydantic import Field, model_validator
+
+from zenav.services.baselines.common import Cycle, FloatArray, MissionParams, returns, wrap
+
+IntArray = npt.NDArray[np.int64]
+
+
+class Params(MissionParams):
+    grid_cell: float = Field(0.1, gt=0, description="histogram grid cell size, m "
+                             "(paper: 10 cm)")
+    grid_extent: float = Field(60.0, gt=0, description="side of the square histogram grid, "
+                               "centred on the first pose, m")
+    window_cells: int = Field(33, ge=3, description="w_s: active window side, cells (odd)")
+    sector_deg: float = Field(5.0, gt=0, le=45, description="alpha: polar sector width, deg")
+    b: float = Field(1.0, gt=0, description="b: magnitude fall-off with distance, 1/m "
+                     "(a = b d_max, so a - b d_max = 0)")
+    certainty_max: int = Field(15, ge=1, description="HIMM: largest certainty value")
+    increment: int = Field(3, ge=1, description="HIMM: certainty added per return in a cell")
+    decrement: int = Field(1, ge=0, description="HIMM: certainty removed per beam through "
+                           "a cell")
+    smoothing: int = Field(5, ge=1, description="l: half-width of the smoothing window, "
+                           "sectors")
+    threshold: float = Field(250.0, gt=0, description="smoothed density below which a sector "
+                             "is free (empirical)")
+    s_max: int = Field(18, ge=1, description="valley width above which a valley is wide, "
+                       "sectors (paper: 18)")
+    h_m: float = Field(600.0, gt=0, description="density straight ahead at which the speed "
+                       "drops to V_min (empirical)")
+    v_min: float = Field(0.0, ge=0, description="V_min: speed added after the reductions, m/s")
+    heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of steering "
+                                "error, 1/s")
+    keep_valley_deg: float = Field(
+        15.0, ge=0, description="beyond the 1991 paper (as VFH+ does): the valley steered "
+        "through last is kept unless another is this much nearer the target, deg; without "
+        "it the robot dithers between two valleys either side of an obstacle on its way")
+
+    @model_validator(mode="after")
+    def _odd_window(self) -> Params:
+        if self.window_cells % 2 == 0:
+            raise ValueError("window_cells must be odd (the robot's cell is the centre)")
+        return self
+
+    @property
+    def sectors(self) -> int:
+        return max(1, round(360.0 / self.sector_deg))
+
+    @property
+    def d_max(self) -> float:
+        """Distance from the robot's cell to a corner of the active window, m."""
+        return math.sqrt(2.0) * (self.window_cells - 1) / 2 * self.grid_cell
+
+    @property
+    def a(self) -> float:
+        return self.b * self.d_max
+
+
+class HistogramGrid:
+    """The certainty grid, updated by HIMM from each scan."""
+
+    def __init__(self, p: Params) -> None:
+        self.p = p
+        self.size = max(p.window_cells, math.ceil(p.grid_extent / p.grid_cell))
+        self.c = np.zeros((self.size, self.size), dtype=np.int16)
+        self.origin: FloatArray | None = None
+
+    def inside(self, points: FloatArray) -> npt.NDArray[np.bool_]:
+        """Which of the (n, 2) world points lie on the grid."""
+        assert self.origin is not None
+        ij = np.floor((points - self.origin) / self.p.grid_cell)
+        return np.asarray(((ij >= 0) & (ij < self.size)).all(axis=1), dtype=np.bool_)
+
+    def indices(self, points: FloatArray) -> tuple[IntArray, IntArray]:
+        """Grid (i along x, j along y) of (n, 2) world points on the grid."""
+        assert self.origin is not None
+        ij = np.floor((points - self.origin) / self.p.grid_cell).astype(np.int64)
+        return ij[:, 0], ij[:, 1]
+
+    def update(self, cycle: Cycle) -> None:
+        p = self.p
+        x, y, heading = cycle.pose
+        if self.origin is None:
+            self.origin = np.array([x, y]) - self.size * p.grid_cell / 2
+        reach = min(p.window_radius, cycle.range_max)
+        hit = returns(cycle, reach)
+        angles = cycle.angles + heading
+        cos, sin = np.cos(angles), np.sin(angles)
+        # HIMM: every cell a beam crosses before its return (or before ``reach``) loses
+        # ``decrement``; every return's cell gains ``increment``.
+        if p.decrement:
+            step = p.grid_cell / 2
+            samples = np.arange(step, reach, step)
+            free_to = np.minimum(cycle.ranges, reach) - p.grid_cell
+            along = samples[None, :] < free_to[:, None]
+            beam, k = np.nonzero(along)
+            s = samples[k]
+            points = np.column_stack((x + s * cos[beam], y + s * sin[beam]))
+            inside = self.inside(points)
+            i, j = self.indices(points[inside])
+            cells = i * self.size + j
+            # one decrement per beam and cell (a beam samples a cell about twice)
+            pairs = np.unique(beam[inside] * self.size * self.size + cells)
+            np.subtract.at(self.c.reshape(-1), pairs % (self.size * self.size), p.decrement)
+        if hit.any():
+            r = cycle.ranges[hit]
+            points = np.column_stack((x + r * cos[hit], y + r * sin[hit]))
+            i, j = self.indices(points[self.inside(points)])
+            np.add.at(self.c, (i, j), p.increment)
+        np.clip(self.c, 0, p.certainty_max, out=self.c)
+
+    def polar_histogram(self, x: float, y: float) -> FloatArray:
+        """Primary polar histogram h_k of the active window round (x, y)."""
+        p = self.p
+        assert self.origin is not None
+        half = p.window_cells // 2
+        ci, cj = (np.floor((np.array([x, y]) - self.origin) / p.grid_cell)).astype(int)
+        i0, i1 = max(ci - half, 0), min(ci + half + 1, self.size)
+        j0, j1 = max(cj - half, 0), min(cj + half + 1, self.size)
+        h = np.zeros(p.sectors)
+        if i0 >= i1 or j0 >= j1:
+            return h
+        window = self.c[i0:i1, j0:j1]
+        ii, jj = np.nonzero(window)
+        if ii.size == 0:
+            return h
+        certainty = window[ii, jj].astype(np.float64)
+        cx = self.origin[0] + (ii + i0 + 0.5) * p.grid_cell
+        cy = self.origin[1] + (jj + j0 + 0.5) * p.grid_cell
+        dx, dy = cx - x, cy - y
+        d = np.hypot(dx, dy)
+        m = certainty**2 * np.maximum(p.a - p.b * d, 0.0)
+        beta = np.arctan2(dy, dx) % (2 * math.pi)
+        k = np.minimum((beta / math.radians(p.sector_deg)).astype(np.int64), p.sectors - 1)
+        return np.bincount(k, weights=m, minlength=p.sectors).astype(np.float64)
+
+
+def smooth(h: FloatArray, l: int) -> FloatArray:  # noqa: E741 (the paper's name)
+    """The paper's smoothing: h'_k = (h_{k-l+1} + 2 h_{k-l+2} + ... + l h_k + ... +
+    h_{k+l-1}) / (2l + 1), circular."""
+    weights = np.concatenate((np.arange(1, l + 1), np.arange(l - 1, 0, -1))).astype(np.float64)
+    out = np.zeros_like(h)
+    for offset, w in zip(range(-(l - 1), l), weights, strict=True):
+        out += w * np.roll(h, -offset)
+    return out / (2 * l + 1)
+
+
+@dataclass(frozen=True)
+class Valley:
+    """Free sectors ``start`` .. ``start + width - 1`` (mod n), as angles [lo, lo + width)."""
+
+    start: int
+    width: int
+
+
+def valleys(free: npt.NDArray[np.bool_]) -> list[Valley]:
+    """Runs of free sectors on the circle (one valley of every sector if all are free)."""
+    n = free.size
+    if free.all():
+        return [Valley(0, n)]
+    if not free.any():
+        return []
+    first_blocked = int(np.flatnonzero(~free)[0])
+    rolled = np.roll(free, -first_blocked)
+    edges = np.diff(np.concatenate(([0], rolled.astype(np.int8), [0])))
+    starts = np.flatnonzero(edges == 1)
+    ends = np.flatnonzero(edges == -1)
+    return [Valley(int((s + first_blocked) % n), int(e - s)) for s, e in zip(starts, ends,
+                                                                             strict=True)]
+
+
+def steer(valley_list: list[Valley], target: float, sector: float, s_max: int,
+          previous: float | None = None, keep_margin: float = 0.0) -> float | None:
+    """Steering direction (rad, world frame) toward ``target`` (rad) through the valley
+    nearest to it; None when no sector is free.
+
+    Each valley offers a direction per border (a wide valley may be entered by either
+    border). The candidate nearest the ``previous`` direction is kept unless another is
+    nearer the target by more than ``keep_margin`` rad.
+    """
+    two_pi = 2 * math.pi
+    margin = s_max * sector / 2
+    found: list[tuple[float, float, float]] = []  # distance to the target, -width, direction
+    for v in valley_list:
+        lo = v.start * sector
+        width = v.width * sector
+        if width >= two_pi - 1e-9:
+            return target
+        to_lo = (lo - target) % two_pi  # counter-clockwise from the target to the border
+        to_hi = (target - (lo + width)) % two_pi  # clockwise to the other border
+        if (target - lo) % two_pi < width:  # the target is in the valley
+            offset = (target - lo) % two_pi
+            if v.width > s_max:  # wide: straight on, but s_max/2 clear of the borders
+                found.append((0.0, -width, lo + min(max(offset, margin), width - margin)))
+            else:
+                found.append((0.0, -width, lo + width / 2))
+            continue
+        if v.width <= s_max:  # narrow: down the middle
+            found.append((min(to_lo, to_hi), -width, lo + width / 2))
+            continue
+        # wide: k_n is the border nearest the target, k_f = k_n +- s_max
+        found.append((to_lo, -width, lo + margin))
+        found.append((to_hi, -width, lo + width - margin))
+    if not found:
+        return None
+    best = min(found, key=lambda f: f[:2])
+    if previous is not None:
+        held = min(found, key=lambda f: abs(wrap(f[2] - previous)))
+        if held[0] <= best[0] + keep_margin:
+            return held[2] % two_pi
+    return best[2] % two_pi
+
+
+@dataclass(frozen=True)
+class Decision:
+    v: float
+    omega: float
+    direction: float | None  # chosen steering direction, rad (None: no free sector)
+    density_ahead: float  # h'_c
+
+
+class VFH:
+    """One VFH planner: the grid it keeps and the command for each scan."""
+
+    def __init__(self, params: Params) -> None:
+        self.p = params
+        self.grid = HistogramGrid(params)
+        self.previous: float | None = None
+
+    def step(self, cycle: Cycle) -> Decision:
+        p = self.p
+        x, y, heading = cycle.pose
+        self.grid.update(cycle)
+        h = smooth(self.grid.polar_histogram(x, y), p.smoothing)
+        sector = math.radians(p.sector_deg)
+        target = math.atan2(cycle.goal[1] - y, cycle.goal[0] - x) % (2 * math.pi)
+        direction = steer(valleys(h < p.threshold), target, sector, p.s_max, self.previous,
+                          math.radians(p.keep_valley_deg))
+        self.previous = direction
+        ahead = float(h[int((heading % (2 * math.pi)) / sector) % p.sectors])
+        if direction is None:
+            emptiest = (int(np.argmin(h)) + 0.5) * sector
+            omega = math.copysign(p.max_omega, wrap(emptiest - heading))
+            return Decision(0.0, omega, None, ahead)
+        omega = max(-p.max_omega, min(p.max_omega, p.heading_gain * wrap(direction - heading)))
+        v_prime = p.cruise_speed * (1.0 - min(ahead, p.h_m) / p.h_m)
+        v = v_prime * (1.0 - abs(omega) / p.max_omega) + p.v_min
+        distance = math.hypot(cycle.goal[0] - x, cycle.goal[1] - y)
+        return Decision(min(v, p.cruise_speed, distance), omega, direction, ahead)

@@ -1,0 +1,30 @@
+"""Measured figures of the deployment tests (stop time after link loss, restart time after
+kill -9, ...), printed in a section of pytest's summary so that they can be quoted."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+
+MEASURED: list[str] = []
+
+
+@pytest.fixture
+def measure(request: pytest.FixtureRequest) -> Callable[[str, float, str], None]:
+    """``measure(name, seconds, detail)``: note one figure for the summary."""
+    test = request.node.name
+
+    def note(name: str, seconds: float, detail: str = "") -> None:
+        line = f"{name}: {seconds:.3f} s{f'  ({detail})' if detail else ''}  [{test}]"
+        MEASURED.append(line)
+        print(f"zenav-measure {line}")
+
+    return note
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
+    if MEASURED:
+        terminalreporter.section("zenav measurements")
+        for line in MEASURED:
+            terminalreporter.write_line(line)

@@ -1,0 +1,206 @@
+"""A long-running stack on one host under supervisord (``zenav up``, deploy/stack.yaml):
+crashed services restarted and rejoining, the planner replaced mid-run, clean stop.
+
+Each stack gets its own router port on loopback; a ``zenav monitor --jsonl`` process
+reports what happens on the bus, with the wall time of each change.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+import yaml
+
+from tests.integration.livestack import (
+    LONG_SCENARIO,
+    REPO,
+    Deployed,
+    Event,
+    Monitor,
+    copy_deployment,
+    monitor_command,
+    moving_at,
+    reached,
+    run,
+    zenav,
+)
+from zenav.launch import free_port_block
+from zenav.sim.scenario import load_scenario
+
+pytestmark = pytest.mark.integration
+
+OUTPUT = {
+    "laser_driver": "scan",
+    "perception": "obstacles",
+    "tracking": "tracks",
+    "planner": "cmd_vel",
+    "motor_bridge": "device/base_cmd",
+    "router": "odom",
+}
+"""What each killed program's comeback is measured on: its output, or for the router the
+robot side's odometry reaching the monitor again."""
+
+
+def outage(monitor: Monitor, topic: str, since: float) -> Callable[[], Event | None]:
+    """Finds the monitor's report of ``topic`` stopping, noticed after ``since``."""
+    def find() -> Event | None:
+        return next((e for e in monitor.events if e["event"] == "flow" and e["topic"] == topic
+                     and not e["flowing"] and e["noticed"] >= since), None)
+    return find
+
+
+def has_tracks_after(since: float) -> Callable[[Event], bool]:
+    def check(snap: Event) -> bool:
+        return bool(snap["wall"] > since and snap["obstacles"])
+    return check
+
+
+def one_host(tmp_path: Path, **changes: object) -> tuple[Deployed, str]:
+    """deploy/stack.yaml on a free loopback port, on the long scenario, at 2x real time."""
+    endpoint = f"tcp/127.0.0.1:{free_port_block(1)}"
+    config = copy_deployment(
+        REPO / "deploy" / "stack.yaml", tmp_path / "stack.yaml", scenario=str(LONG_SCENARIO),
+        router={"listen": [endpoint]}, transport={"mode": "client", "connect": [endpoint]},
+        **changes)
+    return Deployed(config, tmp_path / "run",
+                    up_args=["--set", "simulator.realtime_factor=2"]), endpoint
+
+
+def test_up_ctl_down_give_a_realtime_stack_with_one_log_per_program(tmp_path):
+    stack, _ = one_host(tmp_path)
+    programs = ["laser_driver", "motor_bridge", "perception", "planner", "router",
+                "simulator", "tracking"]
+    try:
+        done = stack.up()
+        assert "alive on the bus" in done.stdout
+        status = stack.ctl("status")
+        assert status.returncode == 0, status.stderr
+        assert sorted(line.split()[0] for line in status.stdout.splitlines()) == programs
+        assert all(" RUNNING " in line for line in status.stdout.splitlines())
+        again = run(zenav("up", "--config", str(stack.config), "--run-dir", str(stack.run_dir)))
+        assert again.returncode == 2 and "already up" in again.stderr, again
+    finally:
+        stopped = stack.down()
+        stack.cleanup()
+    assert stopped.returncode == 0 and "stopped cleanly" in stopped.stdout, stopped.stderr
+    logs = {p.stem for p in (stack.run_dir / "logs").glob("*.log")}
+    assert logs == {*programs, "supervisord"}
+    assert "all services alive" in (stack.run_dir / "logs" / "simulator.log").read_text()
+    # Stopped in reverse start order: planner first (the bridge stops the wheels), router last.
+    lines = (stack.run_dir / "logs" / "supervisord.log").read_text().splitlines()
+    order = [line.split("stopped: ")[1].split()[0] for line in lines if "stopped: " in line]
+    assert order == ["planner", "tracking", "perception", "laser_driver", "simulator",
+                     "motor_bridge", "router"]
+    assert all("(exit status 0)" in line for line in lines if "stopped: " in line)
+    assert Deployed(stack.config, stack.run_dir).supervisor.pid() is None
+
+
+def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_others(
+        tmp_path, measure):
+    stack, endpoint = one_host(tmp_path)
+    monitor = None
+    start_x = load_scenario(LONG_SCENARIO).robot.start[0]
+    times: dict[str, dict[str, float]] = {}
+    try:
+        stack.up()
+        monitor = Monitor(monitor_command(endpoint), tmp_path / "monitor.log")
+        monitor.state("steady data on every output (so that an outage shows)",
+                      lambda s: all(s["rates"].get(o, 0) > 5 for o in OUTPUT.values()), 20)
+        x = start_x + 0.2
+        for program, output in OUTPUT.items():
+            snap = monitor.state(f"the robot under way before killing {program}",
+                                 moving_at(x), timeout=20)
+            before = stack.pids()
+            killed = time.time()
+            os.kill(before[program], signal.SIGKILL)
+            deadline = time.monotonic() + 10
+            while (pid := stack.pids()[program]) in (before[program], 0):
+                assert time.monotonic() < deadline, f"{program} not restarted"
+                time.sleep(0.01)
+            spawned = time.time()
+            back = monitor.event("alive", 10, after=killed, service=program, alive=True)
+            stopped = monitor.wait(f"{output} stopping after the kill",
+                                   outage(monitor, output, killed), timeout=10)
+            flowing = monitor.event("flow", 10, after=stopped["noticed"], topic=output,
+                                    flowing=True)
+            times[program] = {"spawned": spawned - killed, "alive": back["wall"] - killed,
+                              "flowing": flowing["wall"] - killed}
+            after = stack.pids()
+            assert after[program] == pid
+            assert {p: after[p] for p in after if p != program} == \
+                {p: before[p] for p in before if p != program}, "another program restarted"
+            if program == "tracking":  # its state is rebuilt from the next messages
+                monitor.state("tracks again after the restart",
+                              has_tracks_after(flowing["wall"]), timeout=10)
+            x = snap["truth"]["x"] + 0.1
+        final = monitor.state("the run's result", reached, timeout=90)
+        assert final["result"]["outcome"] == "reached", final["result"]
+        assert final["result"]["collided_with"] is None
+        rejoins = {name: s["rejoins"] for name, s in final["services"].items()}
+        assert all(rejoins[p] >= 1 for p in OUTPUT), rejoins
+        assert all(s["alive"] for s in final["services"].values())
+    finally:
+        if monitor is not None:
+            monitor.stop()
+        stopped = stack.down() if stack.is_up else None
+        stack.cleanup()
+    assert stopped is not None and stopped.returncode == 0, stopped
+    for program, t in times.items():
+        measure(f"kill -9 {program} -> data flowing again ({OUTPUT[program]})", t["flowing"],
+                f"respawned {t['spawned']:.3f} s, liveliness back {t['alive']:.3f} s")
+    assert all(t["flowing"] < 5.0 for t in times.values()), times
+
+
+def test_the_planner_replaced_mid_run_stops_the_robot_meanwhile_and_it_reaches_the_goal(
+        tmp_path, measure):
+    scenario = load_scenario(LONG_SCENARIO)
+    goal, speed = scenario.robot.goal, scenario.robot.speed
+    replacement = {"service": "planner", "autostart": False, "command": [
+        "{python}", str(REPO / "tests" / "integration" / "replacement_planner.py"),
+        "--transport", "{transport}", "--robot-id", "{robot_id}",
+        "--goal", str(goal[0]), str(goal[1]), "--speed", str(speed)]}
+    services = copy_deployment(REPO / "deploy" / "stack.yaml", tmp_path / "base.yaml")
+    programs = yaml.safe_load(services.read_text())["services"]
+    stack, endpoint = one_host(tmp_path, services={**programs, "planner_b": replacement})
+    monitor = None
+    try:
+        stack.up()
+        monitor = Monitor(monitor_command(endpoint), tmp_path / "monitor.log")
+        monitor.state("the robot under way", moving_at(scenario.robot.start[0] + 0.5), 20)
+
+        stopping = time.time()
+        done = stack.ctl("stop", "planner")
+        assert done.returncode == 0 and "stopped" in done.stdout, done.stdout + done.stderr
+        gone = monitor.event("alive", 5, after=stopping, service="planner", alive=False)
+        stale = monitor.event("base", 5, after=stopping, reason="stale")
+        still = monitor.event("motion", 5, after=stopping, source="truth", moving=False)
+
+        starting = time.time()
+        done = stack.ctl("start", "planner_b")
+        assert done.returncode == 0 and "started" in done.stdout, done.stdout + done.stderr
+        assert not [e for e in monitor.events if stopping < e["wall"] < starting and
+                    e["event"] == "motion" and e["source"] == "truth" and e["moving"]]
+        moving = monitor.event("motion", 15, after=starting, source="truth", moving=True)
+        final = monitor.state("the run's result", reached, timeout=90)
+        assert final["result"]["outcome"] == "reached", final["result"]
+        assert final["result"]["collided_with"] is None
+        assert final["truth"]["x"] > still["x"] + 1.0  # it went on after the swap
+        infos = stack.supervisor.processes()
+        assert infos["planner"]["statename"] == "STOPPED"
+        assert infos["planner_b"]["statename"] == "RUNNING"
+    finally:
+        if monitor is not None:
+            monitor.stop()
+        stopped = stack.down() if stack.is_up else None
+        stack.cleanup()
+    assert stopped is not None and stopped.returncode == 0, stopped
+    log = (stack.run_dir / "logs" / "planner_b.log").read_text()
+    assert "replacement planner stopped after" in log and " 0 commands" not in log
+    measure("planner stopped -> zero base command (stale)", stale["wall"] - gone["wall"])
+    measure("planner stopped -> robot at standstill", still["wall"] - stopping)
+    measure("replacement started -> robot moving", moving["wall"] - starting)
