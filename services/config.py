@@ -107,11 +107,20 @@ def loopback_port(service: str, base_port: int = DEFAULT_BASE_PORT) -> int:
     return base_port + SERVICE_ORDER.index(service)
 
 
-def loopback_mesh(service: str | None, base_port: int = DEFAULT_BASE_PORT) -> TransportConfig:
+def loopback_mesh(
+    service: str | None, base_port: int = DEFAULT_BASE_PORT, *, tool_listens: bool = False
+) -> TransportConfig:
     """The embedded default: every service a peer on its own loopback port, connected to
-    all the others. ``service=None`` is a tool (run, monitor): it listens on nothing and
-    connects to every service."""
+    all the others and to the tool port after them (``base_port + 6``).
+
+    ``service=None`` is a tool (zenav run, a monitor): it connects to every service. The
+    one tool that drives a run also listens on the tool port (``tool_listens``), so the
+    links to it are made from both ends and come up as soon as either side starts.
+    """
     endpoints = {name: f"tcp/127.0.0.1:{loopback_port(name, base_port)}" for name in SERVICE_ORDER}
-    listen = [endpoints[service]] if service is not None else []
-    connect = [ep for name, ep in endpoints.items() if name != service]
-    return TransportConfig(mode="peer", listen=listen, connect=connect)
+    tool = f"tcp/127.0.0.1:{base_port + len(SERVICE_ORDER)}"
+    if service is None:
+        return TransportConfig(mode="peer", listen=[tool] if tool_listens else [],
+                               connect=list(endpoints.values()))
+    connect = [ep for name, ep in endpoints.items() if name != service] + [tool]
+    return TransportConfig(mode="peer", listen=[endpoints[service]], connect=connect)

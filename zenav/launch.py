@@ -15,7 +15,7 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -74,7 +74,7 @@ class Stack:
     params: Mapping[str, Mapping[str, Any]]
     robot_id: str = "robot0"
     base_port: int = field(default_factory=free_port_block)
-    services: Iterable[str] = SERVICE_ORDER
+    services: tuple[str, ...] = SERVICE_ORDER
     log_level: str = "INFO"
     planner: str = "paper"
     processes: dict[str, subprocess.Popen[bytes]] = field(default_factory=dict)
@@ -105,9 +105,10 @@ class Stack:
                 stdin=subprocess.DEVNULL,
             )
 
-    def transport(self) -> Any:
-        """Transport settings for a tool process joining this stack."""
-        return loopback_mesh(None, self.base_port)
+    def transport(self, driver: bool = False) -> Any:
+        """Transport settings for a tool process joining this stack; ``driver`` for the
+        one tool that runs it (it also listens on the stack's tool port)."""
+        return loopback_mesh(None, self.base_port, tool_listens=driver)
 
     def failure(self) -> str | None:
         """A one-line reason if a service has exited, else None."""

@@ -9,6 +9,7 @@ ends the command with a one-line reason and a non-zero status, never a hang.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import math
 import time
@@ -94,8 +95,33 @@ def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> 
 async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, list[PlannerEvent]]:
     """Join the stack, gather events until the simulator's result arrives."""
     k = Keys(stack.robot_id)
-    bus = ZenohBus(stack.transport(), asyncio.get_running_loop())
+    bus = ZenohBus(stack.transport(driver=True), asyncio.get_running_loop())
     try:
+        # Announce this run (the simulator waits for it) only once every service is
+        # seen from here: peers relay nothing, so each must be linked to this process.
+        alive: set[str] = set()
+        everyone = asyncio.Event()
+
+        def on_alive(key: str, up: bool) -> None:
+            service = key.rsplit("/", 1)[-1]
+            if up:
+                alive.add(service)
+            else:
+                alive.discard(service)
+            if set(stack.services) <= alive:
+                everyone.set()
+
+        bus.watch_liveliness(k.alive_any, on_alive)
+        deadline = time.monotonic() + progress_timeout
+        while not everyone.is_set():
+            failure = stack.failure()
+            if failure:
+                raise RunError(failure)
+            if time.monotonic() > deadline:
+                missing = ", ".join(sorted(set(stack.services) - alive))
+                raise RunError(f"services not reachable after {progress_timeout:.0f} s: {missing}")
+            with contextlib.suppress(TimeoutError):
+                await asyncio.wait_for(everyone.wait(), timeout=0.1)
         token = bus.declare_token(k.alive("run"))
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
