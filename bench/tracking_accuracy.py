@@ -31,7 +31,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from zenav.schemas.messages import LaserScan
 from zenav.services.perception.clustering import cluster_scan
+from zenav.services.perception.perceive import Perceiver
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Track, Tracker
@@ -157,6 +159,8 @@ def run_case(scenario: Scenario, method: Method, moving: bool, duration: float) 
     angles = laser.angles_rad()
     rng = np.random.default_rng(scenario.seed)
     tracker = Tracker(method.tracking)
+    smoothed = method.tracking.method == "smoothed"
+    perceiver = Perceiver(method.perception) if smoothed else None
     tally = Tally()
     first_seen: dict[int, float] = {}
     frames_seen: dict[int, int] = {}
@@ -168,10 +172,18 @@ def run_case(scenario: Scenario, method: Method, moving: bool, duration: float) 
         ranges = simulate_scan(
             pose[:2], pose[2], angles, snap, laser.max_range, laser.noise_std, rng
         )
-        clusters = cluster_scan(
-            ranges, float(angles[0]), laser.angle_increment_rad, 0.0, laser.max_range,
-            pose, method.perception,
-        )  # fmt: skip
+        if perceiver is not None:  # the stack's perception: clustering + the motion cue
+            scan = LaserScan(
+                stamp=t, seq=i, frame="laser", angle_min=float(angles[0]),
+                angle_max=float(angles[-1]), angle_increment=laser.angle_increment_rad,
+                range_min=0.0, range_max=laser.max_range, ranges=ranges,
+            )  # fmt: skip
+            clusters = perceiver.process(scan, pose)
+        else:  # the paper's: clustering alone
+            clusters = cluster_scan(
+                ranges, float(angles[0]), laser.angle_increment_rad, 0.0, laser.max_range,
+                pose, method.perception,
+            )  # fmt: skip
         tracks = tracker.update(t, pose, clusters)  # coasting tracks count: the planner gets them
         truth = np.asarray(
             cast_rays(pose[:2], pose[2] + angles, snap.disc_centers, snap.disc_radii,

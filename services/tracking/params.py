@@ -128,6 +128,11 @@ class TrackingParams(BaseModel):
         description="(smoothed) free-space motion score (perception's motion cue) at or above "
         "which a cluster counts as having moved.",
     )
+    cue_warmup: float = Field(
+        0.5, ge=0.0, description="seconds (smoothed): a track this young, which the motion cue "
+        "cannot judge yet, is dynamic when its filtered speed is above dynamic_speed and "
+        "significant; older tracks go by the cue.",
+    )
     moved_hold: float = Field(
         1.0, ge=0.0, description="seconds (smoothed): a track stays dynamic this long after "
         "the motion cue last fired.",

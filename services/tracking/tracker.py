@@ -150,6 +150,7 @@ class _State:
     last_seen: float
     merged_since: float | None
     last_moved: float | None = None  # stamp of the last frame the motion cue fired
+    born: float = 0.0  # stamp of the first frame
 
 
 @dataclass(slots=True)
@@ -529,7 +530,7 @@ class Tracker:
             partial=m.partial, n_parts=m.n_parts,
             xi=0.0, varsigma=0.0, delta=math.inf,
             paper_vx=0.0, paper_vy=0.0, paper_d=0.0,
-            age=1, last_seen=stamp, merged_since=None,
+            age=1, last_seen=stamp, merged_since=None, born=stamp,
         )  # fmt: skip
         self._next_id += 1
         return t
@@ -576,7 +577,8 @@ class Tracker:
         """Type from the free-space motion cue when perception measures it, else from the
         filtered speed alone; with hysteresis; "new" for the first frames.
 
-        With the cue, a track is dynamic while the cue fired within ``moved_hold`` s. The
+        With the cue, a track is dynamic while the cue fired within ``moved_hold`` s (or,
+        in its first ``cue_warmup`` s, while the filter is sure of a high speed). The
         filtered speed alone cannot tell a slow walker from the drift of a box's visible
         part as the robot drives past (at 0.5 m/s that drift exceeds 0.2 m/s); the cue
         can. A fast mover just come into view is caught by the cue's 0.5 s baseline."""
@@ -591,7 +593,12 @@ class Tracker:
             still_going = (t.kind == "dynamic" and speed >= p.static_speed
                            and t.last_moved is not None
                            and stamp - t.last_moved <= p.moved_hold + p.drop_after)
-            return "dynamic" if moving or still_going else "static"
+            # Before the cue has an earlier scan to compare with, a confident filter speed
+            # well above walking pace decides (a fast mover that just came into view).
+            significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))
+            warming_up = stamp - t.born < p.cue_warmup
+            fast = warming_up and speed > p.dynamic_speed and significant
+            return "dynamic" if moving or still_going or fast else "static"
         if t.kind == "dynamic":
             return "dynamic" if speed >= p.static_speed else "static"
         significant = speed > p.speed_sigmas * math.sqrt(max(t.p11, 0.0))
