@@ -422,13 +422,13 @@ class Planner:
         found = {a.obstacle.id: a for a in notes}
         by_id = {o.id: o for o in in_window}
         for ob_id, held in self.commitments.items():
-            ob = by_id.get(ob_id)
-            if (held.letter != "e" or held.last is None or ob is None
+            crosser = by_id.get(ob_id)
+            if (held.letter != "e" or held.last is None or crosser is None
                     or any(a.obstacle.id == ob_id for a in threats)
-                    or self._crossed(robot, target, ob)):
+                    or self._crossed(robot, target, crosser)):
                 continue
             seen = found.get(ob_id)
-            base = seen if seen is not None else dataclasses.replace(held.last, obstacle=ob)
+            base = seen if seen is not None else dataclasses.replace(held.last, obstacle=crosser)
             threats.append(dataclasses.replace(base, letter="e", threat=True))
         threat_ids = {a.obstacle.id for a in threats}
         self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}

@@ -1,0 +1,70 @@
+"""``zenav router``: a Zenoh router in a Python session, for a stack spread over hosts.
+
+A Python session opened in ``router`` mode is a complete Zenoh router; no ``zenohd``
+binary is needed. The robot runs one (under the supervisor, with the robot-side
+services as its clients); the server side's services and any monitor connect to it as
+clients. It holds the liveliness token ``zenav/<robot>/alive/router`` so monitors see it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import threading
+from types import FrameType
+from typing import Any
+
+import zenoh
+
+from zenav.schemas.keys import Keys, check_robot_id
+from zenav.services.config import ConfigError
+from zenav.services.runner import setup_logging, transport_from_args
+from zenav.services.transport import TransportConfig
+
+log = logging.getLogger(__name__)
+
+DEFAULT_LISTEN = "tcp/0.0.0.0:7447"
+"""Zenoh's own router port, on every interface of the robot."""
+
+
+def router_transport(args: argparse.Namespace) -> TransportConfig:
+    if args.transport is None and not args.listen and not args.connect:
+        config = TransportConfig(mode="router", listen=[DEFAULT_LISTEN])
+    else:
+        config = transport_from_args(args, None)
+    return config.model_copy(update={"mode": "router"})
+
+
+def main(args: argparse.Namespace) -> int:
+    setup_logging(args.log_level, "router")
+    try:
+        keys = Keys(check_robot_id(args.robot_id))
+        transport = router_transport(args)
+    except (ConfigError, ValueError) as exc:
+        print(f"zenav router: {exc}", file=sys.stderr)
+        return 2
+    stop = threading.Event()
+
+    def on_signal(signum: int, frame: FrameType | None) -> None:
+        stop.set()
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, on_signal)
+    try:
+        session: Any = zenoh.open(transport.to_zenoh())
+    except Exception as exc:
+        log.error("cannot open the router on %s: %s", ", ".join(transport.listen), exc)
+        return 1
+    token = session.liveliness().declare_token(keys.alive("router"))
+    log.info("router up, listening on %s%s", ", ".join(transport.listen),
+             f", connected to {', '.join(transport.connect)}" if transport.connect else "")
+    try:
+        while not stop.wait(0.5):
+            pass
+    finally:
+        token.undeclare()
+        session.close()
+    log.info("router stopped")
+    return 0
