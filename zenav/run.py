@@ -176,6 +176,7 @@ def run_scenario(
     overrides: list[str] | None = None,
     progress_timeout: float = 90.0,
     log_level: str = "INFO",
+    picture: bool = True,
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
@@ -199,7 +200,8 @@ def run_scenario(
     if unclean:
         record["unclean_exits"] = unclean
     (out_dir / "run.json").write_text(json.dumps(record, indent=1))
-    from zenav.plot import plot_run  # matplotlib is slow to import; only here
+    if picture:
+        from zenav.plot import plot_run  # matplotlib is slow to import; only here
 
-    plot_run(scenario, record, out_dir / "run.png")
+        plot_run(scenario, record, out_dir / "run.png")
     return record
