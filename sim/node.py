@@ -69,6 +69,10 @@ class Params(BaseModel):
     retransmit_after: float = Field(0.5, gt=0, description="wall s before a frame is resent")
     answer_timeout: float = Field(30.0, gt=0, description="wall s without an answer: fail")
     result_repeat: float = Field(0.5, gt=0, description="wall s between result repeats")
+    base_timeout: float = Field(
+        1.0, gt=0, description="realtime: the simulated base holds its last command at most "
+        "this many wall s, then stops (a base's own watchdog, for when the bridge is gone)"
+    )
 
 
 class StackSilentError(RuntimeError):
@@ -225,6 +229,7 @@ class Service:
         self.truth = node.publisher(keys.TRUTH, GroundTruth)
         self.result = node.publisher(keys.RESULT, RunResult, reliable=True)
         self.command = BaseCommand(stamp=0.0, seq=0, v=0.0, omega=0.0, reason="idle")
+        self.command_wall = time.monotonic()
         self._answered = asyncio.Event()
         self._alive: set[str] = set()
         self._alive_changed = asyncio.Event()
@@ -234,6 +239,7 @@ class Service:
     def on_base_command(self, command: BaseCommand) -> None:
         if command.stamp >= self.command.stamp:
             self.command = command
+            self.command_wall = time.monotonic()
         if command.stamp >= self.sim.t - 1e-9:
             self._answered.set()
 
@@ -305,7 +311,10 @@ class Service:
             elif not lockstep:
                 wake = started + sim.t / self.params.realtime_factor
                 await asyncio.sleep(max(0.0, wake - time.monotonic()))
-            sim.step(self.command.v, self.command.omega)
+            v, omega = self.command.v, self.command.omega
+            if not lockstep and time.monotonic() - self.command_wall > self.params.base_timeout:
+                v = omega = 0.0  # nothing from the bridge for too long: the base stops
+            sim.step(v, omega)
         self.publish_tick(with_scan=False)
         result = sim.result()
         log.info("run %s ended: %s at t=%.2f s", sim.scenario.name, result.outcome, result.time)

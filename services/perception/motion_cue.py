@@ -84,26 +84,35 @@ def motion_scores(
     """
     n = len(cluster_beams)
     scores = np.zeros(n)
-    if n == 0:
+    if n == 0 or len(window_beams) == 0:
         return scores
-    in_window = np.zeros(current.ranges.shape[0], dtype=bool)
-    in_window[window_beams] = True
-    past_points = past.points(past_beams)
-    vacated_all = seen_free(current, past_points, margin) if len(past_points) else None
+    # Which cluster each window beam belongs to (-1: none), in one pass.
+    owner = np.full(current.ranges.shape[0], -1, dtype=np.int64)
     for k, (first, last) in enumerate(cluster_beams):
-        beams = np.arange(first, last + 1)
-        beams = beams[in_window[beams]]
-        if len(beams) == 0:
-            continue
-        points = current.points(beams)
-        entered = float(seen_free(past, points, margin).mean())
-        vacated = 0.0
-        if vacated_all is not None:
-            lo, hi = points.min(axis=0) - reach, points.max(axis=0) + reach
-            near = np.all((past_points >= lo) & (past_points <= hi), axis=1)
-            if near.sum() >= 2:
-                vacated = float(vacated_all[near].mean())
-        scores[k] = max(entered, vacated)
+        owner[first: last + 1] = k
+    beams = window_beams[owner[window_beams] >= 0]
+    if len(beams) == 0:
+        return scores
+    member = owner[beams]
+    points = current.points(beams)
+    counts = np.bincount(member, minlength=n)
+    entered = np.bincount(member, weights=seen_free(past, points, margin), minlength=n)
+    scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
+    if len(past_beams) >= 2:
+        past_points = past.points(past_beams)
+        vacated = seen_free(current, past_points, margin)
+        lo = np.full((n, 2), np.inf)
+        hi = np.full((n, 2), -np.inf)
+        np.minimum.at(lo, member, points)
+        np.maximum.at(hi, member, points)
+        lo -= reach
+        hi += reach
+        near = np.all((past_points[:, None, :] >= lo[None]) & (past_points[:, None, :] <= hi[None]),
+                      axis=2)  # (past points, clusters)
+        n_near = near.sum(axis=0)
+        gone = (near & vacated[:, None]).sum(axis=0)
+        share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
+        scores = np.maximum(scores, share)
     return scores
 
 

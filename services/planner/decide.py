@@ -267,7 +267,34 @@ class Planner:
                 best_who = who
             if t > best_t:
                 best_v, best_t = v, t
-        return best_v, best_who
+        return best_v, best_who or who
+
+    def escape(
+        self, robot: Vec, direction: Vec, movers: list[Obstacle], statics: list[Obstacle]
+    ) -> tuple[Vec, float] | None:
+        """When no speed along ``direction`` avoids a mover (one coming head-on while the
+        robot waits for a crosser, say): the straight way off, nearest in angle to
+        ``direction``, on which neither a mover comes within the clearance in the safety
+        horizon nor a standing obstacle lies. (direction, speed), or None if there is none.
+        """
+        p = self.p
+        lows, highs = self._boxes(statics)
+        need = p.robot_radius + p.safety_margin
+        step = math.radians(p.fan_step_deg) * 3
+        turns = sorted((k * step for k in range(-11, 12) if k), key=lambda g: (abs(g), g))
+        for g in turns:
+            c, s = math.cos(g), math.sin(g)
+            d = np.array([direction[0] * c - direction[1] * s, direction[0] * s + direction[1] * c])
+            for v in (p.cruise_speed, p.max_speed):
+                if not math.isinf(self._first_contact(robot, d * v, movers)[0]):
+                    continue
+                if len(lows):
+                    way = path_points(robot, d, max(v * p.safety_horizon, p.cell), p.cell / 4)
+                    gaps = gap_to_boxes(way, lows, highs)
+                    if (gaps < min(need, float(gaps[0]) - 1e-6)).any():
+                        continue
+                return d, v
+        return None
 
     def _first_contact(
         self, robot: Vec, velocity: Vec, movers: list[Obstacle]
@@ -307,6 +334,11 @@ class Planner:
         away = float(d[0] * ob.velocity[1] - d[1] * ob.velocity[0])
         clearance = self.p.robot_radius + ob.radius + self.p.safety_margin
         return side * away > 0 and abs(side) > clearance
+
+    @staticmethod
+    def _toward(direction: Vec, ob: Obstacle) -> bool:
+        """Whether ``ob`` comes at the robot against ``direction`` (head-on)."""
+        return float(direction @ np.asarray(ob.velocity)) < 0.0
 
     def _unconfirmed(self, a: Assessment, stamp: float) -> bool:
         """A standing obstacle seen for less than ``confirm_time`` may yet turn out to move
@@ -482,7 +514,22 @@ class Planner:
         if movers and float(np.hypot(*offset)) > 1e-9:
             direction = offset / float(np.hypot(*offset))
             safe, culprit = self.safe_speed(robot, direction, speed, movers)
-            if safe != speed and culprit is not None:
+            doomed = not math.isinf(self._first_contact(robot, direction * safe, movers)[0])
+            way_off = self.escape(robot, direction, movers, self._statics(in_window)) \
+                if doomed else None
+            if way_off is not None and culprit is not None:
+                # Step aside: a straight detour, like a Morphin candidate, clear of all.
+                d, v = way_off
+                target = robot + d * max(v * p.safety_horizon, p.cell)
+                self.detour = Detour(target, culprit.id, "f" if self._toward(d, culprit)
+                                     else "e", 0)
+                speed, action = v, "morphin"
+                why = next((a for a in notes if a.obstacle.id == culprit.id), None)
+                if why is not None:
+                    lead = why
+                    if why not in threats:
+                        threats.append(why)
+            elif safe != speed and culprit is not None:
                 why = next((a for a in notes if a.obstacle.id == culprit.id), None)
                 if action != "morphin" or safe <= 0.0:
                     action = "speed_up" if safe > speed else ("stop" if safe <= 0.0 else "slow")
