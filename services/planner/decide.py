@@ -109,7 +109,8 @@ class Planner:
         s0 = float((robot - self.start) @ unit)
         default = self.goal if s0 + p.lookahead >= length else (
             self.start + unit * max(s0 + p.lookahead, 0.0))
-        off_path = abs(float(np.cross(unit, robot - self.start)))
+        rel = robot - self.start
+        off_path = abs(float(unit[0] * rel[1] - unit[1] * rel[0]))
         if not statics or off_path < p.cell / 2:
             return default
         rejoin = self._rejoin_point(robot, statics)
