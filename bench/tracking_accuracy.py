@@ -33,8 +33,8 @@ import numpy.typing as npt
 
 from zenav.schemas.messages import LaserScan
 from zenav.services.perception.clustering import cluster_scan
-from zenav.services.perception.perceive import Perceiver
 from zenav.services.perception.params import PerceptionParams
+from zenav.services.perception.perceive import Perceiver
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Track, Tracker
 from zenav.sim.raycast import cast_rays, simulate_scan

@@ -58,6 +58,9 @@ def decode(
         fields = msgpack.unpackb(payload, raw=False, strict_map_key=True)
     except (ValueError, msgpack.ExtraData, msgpack.FormatError, msgpack.StackError) as exc:
         raise DecodeError(key, "msgpack", f"not a msgpack payload ({exc})") from None
+    except (TypeError, RecursionError, OverflowError, MemoryError) as exc:
+        # e.g. an array used as a map key, or nesting deeper than the stack
+        raise DecodeError(key, "msgpack", f"unusable msgpack ({type(exc).__name__})") from None
     if not isinstance(fields, dict):
         raise DecodeError(key, "envelope", f"expected a map, got {type(fields).__name__}")
     version = fields.pop("_v", None)
@@ -74,6 +77,8 @@ def decode(
         return message_type.model_validate(fields)
     except ValidationError as exc:
         raise DecodeError(key, "invalid", _summarise(exc)) from None
+    except Exception as exc:  # a validator failing in a way pydantic does not wrap
+        raise DecodeError(key, "invalid", f"{type(exc).__name__}: {exc}"[:300]) from None
 
 
 def _summarise(exc: ValidationError) -> str:

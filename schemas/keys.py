@@ -40,13 +40,15 @@ class Topic:
     max_bytes: int = 64 * 1024
 
 
-RAW_LASER = Topic("device/laser", RawLaserFrame)
-BASE_CMD = Topic("device/base_cmd", BaseCommand)
-SCAN = Topic("scan", LaserScan)
-ODOM = Topic("odom", Odometry)
-OBSTACLES = Topic("obstacles", ObstacleChain)
-TRACKS = Topic("tracks", TrackList)
-CMD_VEL = Topic("cmd_vel", VelocityCommand)
+# Largest payloads, with room to spare: a 3601-beam scan (0.1 deg over 360 deg) is ~14.5 KB;
+# odometry and commands are ~100 B; 400 obstacles or tracks are ~120 KB.
+RAW_LASER = Topic("device/laser", RawLaserFrame, max_bytes=32 * 1024)
+BASE_CMD = Topic("device/base_cmd", BaseCommand, max_bytes=1024)
+SCAN = Topic("scan", LaserScan, max_bytes=32 * 1024)
+ODOM = Topic("odom", Odometry, max_bytes=1024)
+OBSTACLES = Topic("obstacles", ObstacleChain, max_bytes=256 * 1024)
+TRACKS = Topic("tracks", TrackList, max_bytes=256 * 1024)
+CMD_VEL = Topic("cmd_vel", VelocityCommand, max_bytes=1024)
 EVENTS = Topic("planner/events", PlannerEvent)
 EVENT_HISTORY = Topic("planner/history", PlannerEvent)  # queryable: every event so far
 PLANNER_STATE = Topic("planner/state", PlannerState)

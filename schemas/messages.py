@@ -132,6 +132,11 @@ class RawLaserFrame(Message):
     def _finite(cls, ranges: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
         if ranges.size == 0:
             raise ValueError("a frame needs at least one range")
+        bad = ~np.isfinite(ranges)
+        if bad.any():
+            raise ValueError(f"non-finite range at beam {int(np.flatnonzero(bad)[0])}")
+        if (ranges < 0).any():
+            raise ValueError(f"negative range at beam {int(np.flatnonzero(ranges < 0)[0])}")
         return ranges
 
 

@@ -34,6 +34,20 @@ LOG_EVERY = 10.0
 STATUS_PERIOD = 1.0
 """Seconds between two status messages (wall clock: this is health, not control)."""
 
+MAX_FUTURE = 5.0
+"""Stamp-clock seconds an input may be ahead of the newest stamp the service has accepted
+on any input (its view of the stack's clock). A later stamp is refused as ``future``:
+accepted, it would make every genuine message after it look out of order."""
+
+RESYNC_AFTER = 1.0
+RESYNC_COUNT = 5
+"""The way back after a long link cut (stamps jump ahead) or a restarted publisher
+(stamps start again): once nothing has been accepted for ``RESYNC_AFTER`` wall seconds
+(on the key for a past stamp, on any input for a future one), ``RESYNC_COUNT`` refused
+stamps in a row on one key that form a coherent stream (increasing, each within
+``MAX_FUTURE`` of the one before) are taken as the new order. A lone stamp, or scattered
+ones, never move the clock."""
+
 
 class TypedPublisher(Generic[M]):
     """Publishes one topic's messages and numbers them."""
@@ -85,7 +99,15 @@ class _RateLimitedLog:
 class Node:
     """One service's connection to the bus."""
 
-    def __init__(self, name: str, bus: Bus, keys: Keys) -> None:
+    def __init__(
+        self,
+        name: str,
+        bus: Bus,
+        keys: Keys,
+        *,
+        max_future: float = MAX_FUTURE,
+        resync_after: float = RESYNC_AFTER,
+    ) -> None:
         self.name = name
         self.bus = bus
         self.keys = keys
@@ -96,7 +118,14 @@ class Node:
         self._tasks: list[asyncio.Task[None]] = []
         self._stop = asyncio.Event()
         self._token: Token | None = None
+        self._accepted_wall = time.monotonic()
         self._log_rejection = _RateLimitedLog(name)
+        self.max_future = max_future
+        self.resync_after = resync_after
+        self.clock: float | None = None
+        """Newest stamp accepted on any input: the service's view of the stack's clock."""
+        self._latest: dict[str, tuple[float, float]] = {}  # key -> (stamp, wall accepted)
+        self._refused: dict[str, tuple[float, int]] = {}  # key -> (last stamp, run length)
         self._status = TypedPublisher[ServiceStatus](
             bus.publisher(keys.status(name)), Topic(f"status/{name}", ServiceStatus)
         )
@@ -166,6 +195,13 @@ class Node:
             except DecodeError as exc:
                 self.reject(key, exc.kind, str(exc))
                 continue
+            except Exception as exc:  # decode promises DecodeError; never lose the input task
+                self.reject(key, "invalid", f"{key}: invalid: {type(exc).__name__}: {exc}")
+                continue
+            refused = self.check_stamp(key, message.stamp)
+            if refused is not None:
+                self.reject(key, *refused)
+                continue
             self.received[topic.name] += 1
             try:
                 result = handler(message)
@@ -176,6 +212,47 @@ class Node:
             except Exception:
                 self.handler_errors += 1
                 log.exception("%s: handler for %s failed; input dropped", self.name, key)
+
+    def check_stamp(self, key: str, stamp: float) -> tuple[str, str] | None:
+        """Order the inputs of one key by stamp, against the service's clock.
+
+        Returns ``None`` to accept ``stamp`` (later than or equal to the key's newest:
+        an equal one is a retransmission the service answers), or ``(kind, text)``:
+        ``out_of_order`` for a stamp earlier than the key's newest, ``future`` for one
+        more than ``max_future`` ahead of :attr:`clock`. See :data:`RESYNC_COUNT` for
+        how the order restarts after a cut link or a restarted publisher.
+        """
+        now = time.monotonic()
+        latest = self._latest.get(key)
+        problem: tuple[str, str] | None = None
+        if latest is not None and stamp < latest[0]:
+            problem = ("out_of_order", f"{key}: out_of_order: stamp {stamp} after {latest[0]}")
+            silent = now - latest[1]
+        elif self.clock is not None and stamp > self.clock + self.max_future:
+            problem = ("future", f"{key}: future: stamp {stamp} is more than "
+                       f"{self.max_future} s ahead of the clock {self.clock}")
+            silent = now - self._accepted_wall
+        if problem is not None:
+            # A refused stamp counts toward a resynchronisation only as part of a
+            # coherent stream: increasing, each within max_future of the one before.
+            run = self._refused.get(key)
+            if run is not None and run[0] < stamp <= run[0] + self.max_future:
+                run = (stamp, run[1] + 1)
+            else:
+                run = (stamp, 1)
+            self._refused[key] = run
+            if run[1] < RESYNC_COUNT or silent < self.resync_after:
+                return problem
+            log.warning("%s: %s refused for %.1f s, then %d coherent stamps; the order "
+                        "restarts at %s", self.name, key, silent, run[1], stamp)
+            if problem[0] == "future":
+                self.clock = stamp
+        self._refused.pop(key, None)
+        self._latest[key] = (stamp, now)
+        self._accepted_wall = now
+        if self.clock is None or stamp > self.clock:
+            self.clock = stamp
+        return None
 
     def reject(self, key: str, kind: str, text: str) -> None:
         """Count an input refused for ``kind`` and log it, rate-limited per key and kind."""

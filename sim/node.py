@@ -21,6 +21,7 @@ import asyncio
 import logging
 import math
 import time
+from collections import deque
 from pathlib import Path
 from typing import Literal
 
@@ -69,6 +70,10 @@ class Params(BaseModel):
     retransmit_after: float = Field(0.5, gt=0, description="wall s before a frame is resent")
     answer_timeout: float = Field(30.0, gt=0, description="wall s without an answer: fail")
     result_repeat: float = Field(0.5, gt=0, description="wall s between result repeats")
+    realtime_history: float = Field(
+        600.0, gt=0, description="realtime: s of trajectory kept for the run result (a live "
+        "stack runs for hours; lockstep runs keep every tick)"
+    )
     base_timeout: float = Field(
         1.0, gt=0, description="realtime: the simulated base holds its last command at most "
         "this many wall s, then stops (a base's own watchdog, for when the bridge is gone)"
@@ -96,7 +101,9 @@ class Simulation:
         self.beam_angles = laser.angles_rad()
         self.rng = np.random.default_rng(scenario.seed)
         self.tick = 0
-        self.rows: list[tuple[float, float, float, float, float]] = []
+        keep = (None if params.clock == "lockstep"
+                else max(1, math.ceil(params.realtime_history / self.dt)))
+        self.rows: deque[tuple[float, float, float, float, float]] = deque(maxlen=keep)
         self.path_length = 0.0
         self.min_clearance = math.inf
         self.outcome: Literal["reached", "collision", "timeout"] | None = None

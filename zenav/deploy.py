@@ -35,6 +35,7 @@ from typing import Any, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from zenav import secure
 from zenav.schemas.keys import check_robot_id
 from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment, read_yaml
 from zenav.services.transport import TransportConfig
@@ -99,6 +100,16 @@ class SupervisorSpec(BaseModel):
     log_backups: int = Field(3, ge=0)
 
 
+class SecuritySpec(BaseModel):
+    """Mutual TLS on every link, and access control on the router (zenav.secure)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    certs: Path = Field(description="directory made by deploy/secure/make-certs.sh, "
+                        "relative to the deployment file")
+    access_control: bool = Field(True, description="the router's default-deny policy")
+
+
 class Deployment(BaseModel):
     """A deployment file."""
 
@@ -114,6 +125,7 @@ class Deployment(BaseModel):
     transport: TransportConfig
     services: dict[str, ProgramSpec]
     supervisor: SupervisorSpec = Field(default_factory=SupervisorSpec)
+    security: SecuritySpec | None = None
 
     @field_validator("robot_id")
     @classmethod
@@ -172,6 +184,14 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
             raise ConfigError(f"{path}: scenario: {exc}") from None
     for spec in deployment.services.values():
         spec.config = [(base / p).resolve() for p in spec.config]
+    if deployment.security is not None:
+        deployment.security.certs = (base / deployment.security.certs).resolve()
+        missing = [f"{name}.pem" for name in ("ca", "router", *secure.PARTIES)
+                   if not (deployment.security.certs / f"{name}.pem").is_file()]
+        if missing:
+            raise ConfigError(f"{path}: security.certs: {deployment.security.certs} lacks "
+                              f"{', '.join(missing)} (make them with "
+                              "deploy/secure/make-certs.sh)")
     for text in overrides:
         program, _, assignment = text.partition(".")
         if program not in deployment.services or not assignment:
@@ -228,7 +248,7 @@ def scenario_params(deployment: Deployment) -> dict[str, dict[str, Any]]:
 def program_command(deployment: Deployment, program: str, run_dir: Path,
                     derived: dict[str, Path], python: str) -> list[str]:
     spec = deployment.services[program]
-    transport = run_dir / "transport.yaml"
+    transport = transport_path(deployment, run_dir, deployment.service_of(program))
     if spec.command is not None:
         values = {"python": python, "transport": str(transport),
                   "robot_id": deployment.robot_id, "log_level": deployment.log_level,
@@ -255,10 +275,40 @@ def program_command(deployment: Deployment, program: str, run_dir: Path,
     return command
 
 
-def router_command(deployment: Deployment, python: str) -> list[str]:
+def transport_path(deployment: Deployment, run_dir: Path, party: str) -> Path:
+    """The transport file of one party: shared, or its own in a secured deployment (its
+    certificate)."""
+    if deployment.security is None:
+        return run_dir / "transport.yaml"
+    return run_dir / f"transport-{party}.yaml"
+
+
+def secured_transport(deployment: Deployment, party: str) -> TransportConfig:
+    """``party``'s transport in a secured deployment: the router listens (TLS, mutual
+    authentication, access control), every other party connects with its certificate."""
+    assert deployment.security is not None
+    certs = deployment.security.certs
+    if party == "router":
+        assert deployment.router is not None
+        extra = secure.tls_settings(certs, "router", listen=True)
+        if deployment.router.connect:
+            extra |= secure.tls_settings(certs, "router", listen=False)
+        if deployment.security.access_control:
+            extra["access_control"] = secure.access_control(deployment.robot_id)
+        return TransportConfig(mode="router", listen=deployment.router.listen,
+                               connect=deployment.router.connect, extra=extra)
+    base = deployment.transport
+    return base.model_copy(update={"extra": {**base.extra, **secure.tls_settings(
+        certs, party, listen=bool(base.listen))}})
+
+
+def router_command(deployment: Deployment, python: str,
+                   run_dir: Path | None = None) -> list[str]:
     assert deployment.router is not None
     command = [python, "-m", "zenav", "router", "--robot-id", deployment.robot_id,
                "--log-level", deployment.log_level]
+    if deployment.security is not None and run_dir is not None:
+        return [*command, "--transport", str(transport_path(deployment, run_dir, "router"))]
     for endpoint in deployment.router.listen:
         command += ["--listen", endpoint]
     for endpoint in deployment.router.connect:
@@ -275,6 +325,14 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
     (run_dir / "params").mkdir(exist_ok=True)
     (run_dir / "transport.yaml").write_text(
         yaml.safe_dump(deployment.transport.model_dump(mode="json"), sort_keys=False))
+    if deployment.security is not None:
+        parties = {deployment.service_of(p) for p in deployment.services} | {"monitor", "run"}
+        if deployment.router is not None:
+            parties.add("router")
+        for party in sorted(parties):
+            transport_path(deployment, run_dir, party).write_text(yaml.safe_dump(
+                secured_transport(deployment, party).model_dump(mode="json"),
+                sort_keys=False))
     derived: dict[str, Path] = {}
     for service, params in scenario_params(deployment).items():
         path = run_dir / "params" / f"{service}.scenario.yaml"
@@ -307,7 +365,8 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
     ]
     programs: list[tuple[str, list[str], bool, int]] = []
     if deployment.router is not None:
-        programs.append(("router", router_command(deployment, python), True, PRIORITY["router"]))
+        programs.append(("router", router_command(deployment, python, run_dir), True,
+                         PRIORITY["router"]))
     for program, spec in deployment.services.items():
         priority = spec.priority or PRIORITY.get(deployment.service_of(program), CUSTOM_PRIORITY)
         programs.append((program, program_command(deployment, program, run_dir, derived, python),
@@ -442,6 +501,8 @@ def wait_alive(deployment: Deployment, services: set[str], timeout: float) -> se
 
     keys = Keys(deployment.robot_id)
     transport = deployment.transport
+    if deployment.security is not None:  # zenav up watches with the monitor's certificate
+        transport = secured_transport(deployment, "monitor")
     if transport.mode == "client":
         extra = {**transport.extra, "connect/timeout_ms": int(timeout * 1000)}
         transport = transport.model_copy(update={"extra": extra})

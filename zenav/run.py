@@ -137,11 +137,16 @@ async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, li
             try:
                 _, payload = await asyncio.wait_for(results.get(), timeout=0.1)
                 result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
-            except TimeoutError:
+            except (TimeoutError, DecodeError):
                 pass
             while odom.pending():
                 _, payload = await odom.get()
-                stamp = decode(payload, Odometry, k.of(keys.ODOM)).stamp
+                try:
+                    stamp = decode(payload, Odometry, k.of(keys.ODOM)).stamp
+                except DecodeError:
+                    continue  # not ours to judge; the services count it
+                if stamp > sim_time + 3600:
+                    continue  # a stamp from nowhere does not prove progress
                 if stamp > sim_time:
                     sim_time, last_progress = stamp, time.monotonic()
             if time.monotonic() - last_progress > progress_timeout:

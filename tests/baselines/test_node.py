@@ -1,0 +1,96 @@
+"""A baseline as the planner service on the in-memory bus: one command per track list,
+stamped with the tracks' stamp, a repeat answered with the same command, events on a
+change of action."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+
+import numpy as np
+import pytest
+
+from tests.service.harness import Harness
+from zenav.schemas import keys
+from zenav.schemas.keys import Keys
+from zenav.schemas.messages import (
+    LaserScan,
+    Odometry,
+    PlannerEvent,
+    PlannerState,
+    Pose2D,
+    TrackList,
+    VelocityCommand,
+)
+from zenav.services.node import Node
+from zenav.services.runner import PLANNER_MODULES, service_module
+from zenav.services.transport import InMemoryBus
+
+POSE = Pose2D(x=2.0, y=5.0, heading=0.0)
+
+
+@asynccontextmanager
+async def planner(name: str, **params: object) -> AsyncIterator[Harness]:
+    bus = InMemoryBus()
+    k = Keys("test")
+    node = Node("planner", bus, k)
+    module = service_module("planner", name)
+    service = module.Service(node, module.Params(goal=(8.0, 5.0), **params))
+    task = asyncio.create_task(node.spin())
+    await asyncio.sleep(0)
+    try:
+        yield Harness(bus, k, node, service)
+    finally:
+        node.request_stop()
+        await asyncio.gather(task, return_exceptions=True)
+
+
+def scan(t: float, ranges: float = 8.0) -> LaserScan:
+    return LaserScan(stamp=t, seq=0, frame="laser", angle_min=-math.pi / 2,
+                     angle_max=math.pi / 2, angle_increment=math.radians(0.5), range_min=0.05,
+                     range_max=8.0, ranges=np.full(361, ranges, dtype=np.float32))
+
+
+def tracks(t: float, pose: Pose2D = POSE) -> TrackList:
+    return TrackList(stamp=t, seq=0, pose=pose, tracks=[])
+
+
+def test_the_baselines_are_planner_implementations():
+    assert {"vfh", "dwa", "apf"} <= set(PLANNER_MODULES)
+
+
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf"])
+async def test_one_command_per_track_list_with_its_stamp_and_repeats_answered(name):
+    async with planner(name, cruise_speed=0.2) as h:
+        for t in (0.0, 0.1):
+            h.send(keys.SCAN, scan(t))
+            h.send(keys.ODOM, Odometry(stamp=t, seq=0, pose=POSE, v=0.2, omega=0.0))
+            await h.settle()
+            h.send(keys.TRACKS, tracks(t))
+            await h.settle()
+        h.send(keys.TRACKS, tracks(0.1))  # a retransmission
+        await h.settle()
+        commands = h.received(keys.CMD_VEL, VelocityCommand)
+        states = h.received(keys.PLANNER_STATE, PlannerState)
+    assert [c.stamp for c in commands] == [0.0, 0.1, 0.1]
+    assert commands[2] == commands[1]
+    assert commands[1].v > 0 and abs(commands[1].omega) < 1e-9  # open road, goal ahead
+    assert [s.action for s in states] == ["keep", "keep"]
+
+
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf"])
+async def test_no_scan_yet_means_stop_and_the_goal_means_stop(name):
+    async with planner(name) as h:
+        h.send(keys.TRACKS, tracks(0.0))
+        await h.settle()
+        h.send(keys.SCAN, scan(0.1))
+        await h.settle()
+        h.send(keys.TRACKS, tracks(0.1, Pose2D(x=7.95, y=5.0, heading=0.0)))
+        await h.settle()
+        commands = h.received(keys.CMD_VEL, VelocityCommand)
+        events = h.received(keys.EVENTS, PlannerEvent)
+    assert [(c.v, c.omega) for c in commands] == [(0.0, 0.0), (0.0, 0.0)]
+    assert [e.action for e in events] == ["stop", "goal"]
+    assert all(e.scenario == "a" for e in events)
