@@ -75,6 +75,19 @@ def _cmd_params(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_paper(args: argparse.Namespace) -> int:
+    from zenav.paper import main as paper_main
+    from zenav.run import RunError
+
+    try:
+        report = paper_main(args.out, quick=args.quick, parallel=args.parallel)
+    except RunError as exc:
+        print(f"zenav paper: {exc}", file=sys.stderr)
+        return 1
+    print(f"report: {report}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="zenav", description="Mobile-robot navigation as Zenoh services."
@@ -99,6 +112,23 @@ def build_parser() -> argparse.ArgumentParser:
 
     schemas = sub.add_parser("schemas", help="write the JSON Schema of every message")
     schemas.add_argument("--out", type=Path, default=Path("schemas/json"))
+
+    paper = sub.add_parser("paper", help="reproduce the paper's experiments as a report")
+    paper.add_argument("--out", type=Path, default=Path("out/paper"), help="report directory")
+    paper.add_argument("--quick", action="store_true",
+                       help="scenario (a) once only (a smoke test of the report)")
+    paper.add_argument("--parallel", type=int, default=2, help="runs at once (default 2)")
+    paper.set_defaults(func=_cmd_paper)
+
+    from zenav.opscli import add_commands  # deployment and tool commands (each sets func)
+
+    add_commands(sub)
+    from zenav.bench import add_commands as add_bench_commands  # zenav bench perf|nav
+
+    add_bench_commands(sub)
+    from zenav.soak import add_command as add_soak_command  # zenav soak
+
+    add_soak_command(sub)
     return parser
 
 
@@ -109,6 +139,8 @@ def main(argv: list[str] | None = None) -> int:
         args, rest = parser.parse_known_args(argv)
         return _cmd_service(args, rest)
     args = parser.parse_args(argv)
+    if hasattr(args, "func"):
+        return int(args.func(args))
     if args.command == "run":
         return _cmd_run(args)
     if args.command == "params":

@@ -12,7 +12,8 @@ The robot follows the negative gradient of a potential:
   ``U_rep = ½ k_rep (1/ρ − 1/ρ0)²``: a push ``k_rep (1/ρ − 1/ρ0) / ρ²`` away from the
   obstacle's closest point, ρ the gap between that point and the footprint. Obstacles are
   the scan's returns cut into segments at range jumps of more than ``segment_gap``
-  (Khatib's per-obstacle closest point).
+  (Khatib's per-obstacle closest point), plus the standing obstacles the tracker
+  remembers out of the 180° field of view (the closest point of each track's disc).
 
 The force is read as a velocity: the robot turns toward it (turn rate proportional to the
 angle, ``heading_gain``) and drives at ``min(V_R, |F|) · max(0, cos angle)``. Like the
@@ -83,6 +84,12 @@ def forces(cycle: Cycle, p: Params) -> tuple[FloatArray, FloatArray, int]:
     attract = p.k_att * to_goal * (1.0 if distance <= p.d_star else p.d_star / distance)
     points = world_points(cycle, returns(cycle, p.window_radius))
     near = closest_points(points, robot, p.segment_gap)
+    kept = cycle.remembered  # standing obstacles out of view, as the tracker keeps them
+    if len(kept):
+        off = robot - kept.positions
+        centre_gap = np.maximum(np.hypot(off[:, 0], off[:, 1]), 1e-9)
+        rim = kept.positions + off * (np.minimum(kept.radii, centre_gap) / centre_gap)[:, None]
+        near = np.concatenate((near, rim))
     away = robot - near
     centre = np.hypot(away[:, 0], away[:, 1])
     rho = np.maximum(centre - p.robot_radius, p.min_gap)

@@ -3,7 +3,8 @@ cycle sees, and small geometry helpers (pure, no I/O).
 
 A cycle sees the laser scan in the robot frame (ranges and beam angles relative to the
 heading), the robot pose at scan time and its velocity, the goal, and the tracked
-obstacles (positions, velocities, radii; only DWA uses their velocities).
+obstacles (positions, velocities, radii; only DWA uses the velocities): the movers, and
+the standing obstacles the tracker still remembers out of the 180° field of view.
 """
 
 from __future__ import annotations
@@ -69,6 +70,7 @@ class Cycle:
     velocity: tuple[float, float]  # v m/s, omega rad/s
     goal: tuple[float, float]  # m
     movers: Obstacles = field(default_factory=Obstacles)  # tracks that move
+    remembered: Obstacles = field(default_factory=Obstacles)  # standing tracks out of view
 
 
 def wrap(angle: float) -> float:
@@ -87,6 +89,17 @@ def world_points(cycle: Cycle, mask: BoolArray) -> FloatArray:
     r = cycle.ranges[mask]
     a = cycle.angles[mask] + heading
     return np.column_stack((x + r * np.cos(a), y + r * np.sin(a)))
+
+
+def disc_points(obstacles: Obstacles, count: int = 16) -> FloatArray:
+    """(n * count, 2) points on the rims of the obstacles' discs."""
+    if len(obstacles) == 0:
+        return np.zeros((0, 2))
+    a = np.linspace(0.0, 2 * math.pi, count, endpoint=False)
+    rim = np.column_stack((np.cos(a), np.sin(a)))
+    points: FloatArray = (obstacles.positions[:, None, :]
+                          + obstacles.radii[:, None, None] * rim[None]).reshape(-1, 2)
+    return points
 
 
 def goal_reached(cycle: Cycle, tolerance: float) -> bool:

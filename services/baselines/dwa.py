@@ -42,6 +42,7 @@ from zenav.services.baselines.common import (
     Cycle,
     FloatArray,
     MissionParams,
+    disc_points,
     returns,
     world_points,
 )
@@ -61,6 +62,8 @@ class Params(MissionParams):
     control_period: float = Field(0.1, gt=0, description="Δt: one scan period, s")
     sim_time: float = Field(2.0, gt=0, description="forward simulation horizon, s")
     sim_granularity: float = Field(0.1, gt=0, description="forward simulation step, s")
+    arc_step: float = Field(0.1, gt=0, description="step along each curvature when "
+                            "looking for the first contact, m")
     vx_samples: int = Field(7, ge=1, description="forward speed samples in the window")
     vth_samples: int = Field(21, ge=1, description="turn rate samples in the window")
     alpha: float = Field(2.0, ge=0, description="weight of heading")
@@ -116,35 +119,51 @@ def plan(cycle: Cycle, p: Params) -> Decision:
     times = p.sim_granularity * np.arange(1, steps + 1, dtype=np.float64)
     px, py, theta = rollout(x, y, heading, v, w, times)
 
-    # Contact on each arc: against the scan's returns, and the movers where they will be.
-    collide = np.zeros(px.shape, dtype=bool)
-    reach = p.v_max * p.sim_time + p.robot_radius + p.safety_margin + 0.5
+    # dist: arc length to the first contact on each curvature (radius v / omega), against
+    # the scan's returns out to dist_cap, and against the movers where they will be when
+    # the robot gets there (over sim_time).
+    reach = p.dist_cap + p.robot_radius + p.safety_margin
     points = world_points(cycle, returns(cycle, min(reach, p.window_radius)))
     movers = cycle.movers
     if len(movers) and len(points):
         gap = np.hypot(points[:, None, 0] - movers.positions[None, :, 0],
                        points[:, None, 1] - movers.positions[None, :, 1])
         points = points[(gap > movers.radii[None, :] + p.mover_clearance).all(axis=1)]
+    points = np.concatenate((points, disc_points(cycle.remembered)))
+    dist = np.full(v.shape, p.dist_cap)
     if len(points):
+        lengths = p.arc_step * np.arange(0, math.floor(p.dist_cap / p.arc_step) + 1,
+                                         dtype=np.float64)
+        moving = v > 1e-6
+        curvature = np.where(moving, w / np.where(moving, v, 1.0), 0.0)
+        ax, ay, _ = rollout(x, y, heading, moving.astype(np.float64), curvature, lengths)
         tree = cKDTree(points)
-        bound = p.robot_radius + p.safety_margin
-        d, _ = tree.query(np.column_stack((px.ravel(), py.ravel())), k=1,
+        here = float(tree.query([x, y], k=1)[0]) - p.robot_radius
+        # Already within the margin (a mover came close, the robot cut a corner): contact
+        # is the footprint itself, so that the arcs that lead out stay admissible.
+        bound = p.robot_radius + (p.safety_margin if here > p.safety_margin else 0.0)
+        d, _ = tree.query(np.column_stack((ax.ravel(), ay.ravel())), k=1,
                           distance_upper_bound=bound)
-        collide |= (d < bound).reshape(px.shape)
+        hit = (d < bound).reshape(ax.shape)
+        first = hit.argmax(axis=1)
+        dist = np.where(hit.any(axis=1), np.maximum(first - 1, 0) * p.arc_step, dist)
+        # Standing still follows no curvature: its dist is the clearance where it stands,
+        # so a stop is not scored as an open road.
+        standing = min(max(here + p.robot_radius - bound, 0.0), p.dist_cap)
+        dist = np.where(moving, dist, standing)
     for position, velocity, radius in zip(movers.positions, movers.velocities, movers.radii,
                                           strict=True):
         mx = position[0] + velocity[0] * times
         my = position[1] + velocity[1] * times
-        collide |= np.hypot(px - mx[None, :], py - my[None, :]) < (
+        hit = np.hypot(px - mx[None, :], py - my[None, :]) < (
             p.robot_radius + radius + p.safety_margin)
-    first = np.where(collide.any(axis=1), collide.argmax(axis=1), -1)
-    # Arc length to the last pose before contact; the "large constant" if none.
-    safe_time = np.where(first >= 0, first * p.sim_granularity, np.inf)
-    dist = np.where(first >= 0, v * safe_time, p.dist_cap)
-    admissible = v <= np.sqrt(2.0 * np.maximum(dist, 0.0) * p.decel_lim_x) + 1e-9
+        first = hit.argmax(axis=1)
+        meet = v * times[first] - v * p.sim_granularity  # the last pose before contact
+        dist = np.where(hit.any(axis=1), np.minimum(dist, np.maximum(meet, 0.0)), dist)
+    admissible = v <= np.sqrt(2.0 * dist * p.decel_lim_x) + 1e-9
 
     gx, gy = cycle.goal
-    end_x, end_y, end_theta = px[:, -1], py[:, -1], theta[:, -1]
+    end_x, end_y, end_theta = px[:, 0], py[:, 0], theta[:, 0]  # after one period
     error = np.abs((np.arctan2(gy - end_y, gx - end_x) - end_theta + math.pi)
                    % (2 * math.pi) - math.pi)
     score = (p.alpha * (1.0 - error / math.pi)

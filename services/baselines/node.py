@@ -23,6 +23,7 @@ from zenav.schemas.messages import (
     Odometry,
     PlannerEvent,
     PlannerState,
+    Track,
     TrackList,
     VelocityCommand,
 )
@@ -48,13 +49,19 @@ class Policy(Protocol):
     def step(self, cycle: Cycle) -> Command: ...
 
 
-def movers_of(tracks: TrackList, moving_speed: float) -> Obstacles:
-    moving = [t for t in tracks.tracks if t.kind == "dynamic" and t.speed >= moving_speed]
+def _obstacles(tracks: list[Track]) -> Obstacles:
     return Obstacles(
-        positions=np.array([[t.x, t.y] for t in moving], dtype=np.float64).reshape(-1, 2),
-        velocities=np.array([[t.vx, t.vy] for t in moving], dtype=np.float64).reshape(-1, 2),
-        radii=np.array([t.radius for t in moving], dtype=np.float64),
+        positions=np.array([[t.x, t.y] for t in tracks], dtype=np.float64).reshape(-1, 2),
+        velocities=np.array([[t.vx, t.vy] for t in tracks], dtype=np.float64).reshape(-1, 2),
+        radii=np.array([t.radius for t in tracks], dtype=np.float64),
     )
+
+
+def movers_of(tracks: TrackList, moving_speed: float) -> tuple[Obstacles, Obstacles]:
+    """The tracks that move, and the standing ones out of view (remembered)."""
+    moving = [t for t in tracks.tracks if t.kind == "dynamic" and t.speed >= moving_speed]
+    standing = [t for t in tracks.tracks if not t.visible and t not in moving]
+    return _obstacles(moving), _obstacles(standing)
 
 
 def latest_at(kept: dict[float, LaserScan] | dict[float, Odometry], stamp: float) -> float | None:
@@ -99,10 +106,11 @@ class BaselineService:
         if at is not None:
             velocity = (self.odometry[at].v, self.odometry[at].omega)
         pose = tracks.pose
+        movers, remembered = movers_of(tracks, p.moving_speed)
         return Cycle(ranges=scan.ranges.astype(np.float64), angles=scan.angles(),
                      range_max=scan.range_max, pose=(pose.x, pose.y, pose.heading),
                      velocity=velocity, goal=p.goal,
-                     movers=movers_of(tracks, p.moving_speed))
+                     movers=movers, remembered=remembered)
 
     def on_tracks(self, tracks: TrackList) -> None:
         order = self.gate.check(tracks.stamp)

@@ -104,49 +104,49 @@ class HistogramGrid:
         self.c = np.zeros((self.size, self.size), dtype=np.int16)
         self.origin: FloatArray | None = None
 
-    def inside(self, points: FloatArray) -> npt.NDArray[np.bool_]:
-        """Which of the (n, 2) world points lie on the grid."""
-        assert self.origin is not None
-        ij = np.floor((points - self.origin) / self.p.grid_cell)
-        return np.asarray(((ij >= 0) & (ij < self.size)).all(axis=1), dtype=np.bool_)
-
-    def indices(self, points: FloatArray) -> tuple[IntArray, IntArray]:
-        """Grid (i along x, j along y) of (n, 2) world points on the grid."""
-        assert self.origin is not None
-        ij = np.floor((points - self.origin) / self.p.grid_cell).astype(np.int64)
-        return ij[:, 0], ij[:, 1]
-
     def update(self, cycle: Cycle) -> None:
         p = self.p
         x, y, heading = cycle.pose
         if self.origin is None:
             self.origin = np.array([x, y]) - self.size * p.grid_cell / 2
+        origin = self.origin
         reach = min(p.window_radius, cycle.range_max)
-        hit = returns(cycle, reach)
         angles = cycle.angles + heading
         cos, sin = np.cos(angles), np.sin(angles)
-        # HIMM: every cell a beam crosses before its return (or before ``reach``) loses
-        # ``decrement``; every return's cell gains ``increment``.
+        # Only the grid round the robot changes: work on that patch.
+        half = math.ceil(reach / p.grid_cell) + 1
+        ci, cj = np.floor((np.array([x, y]) - origin) / p.grid_cell).astype(int)
+        i0, i1 = max(ci - half, 0), min(ci + half + 1, self.size)
+        j0, j1 = max(cj - half, 0), min(cj + half + 1, self.size)
+        if i0 >= i1 or j0 >= j1:
+            return
+        patch = self.c[i0:i1, j0:j1]
+        rows, cols = patch.shape
+
+        def counts(px: FloatArray, py: FloatArray) -> IntArray:
+            i = np.floor((px - origin[0]) / p.grid_cell).astype(np.int64) - i0
+            j = np.floor((py - origin[1]) / p.grid_cell).astype(np.int64) - j0
+            ok = (i >= 0) & (i < rows) & (j >= 0) & (j < cols)
+            found: IntArray = np.bincount(i[ok] * cols + j[ok],
+                                          minlength=rows * cols).reshape(rows, cols)
+            return found
+
+        # HIMM: each cell a beam crosses before its return (within the active window's
+        # reach) loses ``decrement``, sampled once per cell length; each return's cell
+        # gains ``increment``.
+        change = np.zeros((rows, cols), dtype=np.int64)
         if p.decrement:
-            step = p.grid_cell / 2
-            samples = np.arange(step, reach, step)
-            free_to = np.minimum(cycle.ranges, reach) - p.grid_cell
-            along = samples[None, :] < free_to[:, None]
-            beam, k = np.nonzero(along)
+            free_reach = min(reach, p.d_max + p.grid_cell)
+            samples = np.arange(p.grid_cell, free_reach, p.grid_cell)
+            free_to = np.minimum(cycle.ranges, free_reach) - p.grid_cell
+            beam, k = np.nonzero(samples[None, :] < free_to[:, None])
             s = samples[k]
-            points = np.column_stack((x + s * cos[beam], y + s * sin[beam]))
-            inside = self.inside(points)
-            i, j = self.indices(points[inside])
-            cells = i * self.size + j
-            # one decrement per beam and cell (a beam samples a cell about twice)
-            pairs = np.unique(beam[inside] * self.size * self.size + cells)
-            np.subtract.at(self.c.reshape(-1), pairs % (self.size * self.size), p.decrement)
+            change -= p.decrement * counts(x + s * cos[beam], y + s * sin[beam])
+        hit = returns(cycle, reach)
         if hit.any():
             r = cycle.ranges[hit]
-            points = np.column_stack((x + r * cos[hit], y + r * sin[hit]))
-            i, j = self.indices(points[self.inside(points)])
-            np.add.at(self.c, (i, j), p.increment)
-        np.clip(self.c, 0, p.certainty_max, out=self.c)
+            change += p.increment * counts(x + r * cos[hit], y + r * sin[hit])
+        patch[...] = np.clip(patch + change, 0, p.certainty_max)
 
     def polar_histogram(self, x: float, y: float) -> FloatArray:
         """Primary polar histogram h_k of the active window round (x, y)."""

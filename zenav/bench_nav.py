@@ -1,0 +1,307 @@
+"""``zenav bench nav``: the planners on the same seeded random worlds, through the whole
+service stack.
+
+Worlds come from :func:`zenav.sim.generate.random_scenario` (static clutter; crossing,
+head-on and overtaking movers; mixed; a circle-crossing crowd), ``--worlds`` of each
+family from seed ``--seed`` on, written as scenario files. Each (planner, world) is one
+``zenav run --planner P`` in a subprocess, ``--jobs`` at a time; a run whose
+``run.json`` is already in ``--out`` is not repeated. Per planner: success, collision and
+timeout rates, mean time to goal and path length on the worlds that every planner
+solved, minimum clearance, and decisions (planner events) per run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import statistics
+import subprocess
+import sys
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+from zenav.bench_perf import machine
+from zenav.sim.generate import FAMILIES, random_scenario
+from zenav.sim.scenario import dump_scenario
+
+TARGET_MIXED_SUCCESS = 0.98  # the paper planner on the mixed set, with 0 collisions
+
+
+@dataclass(frozen=True)
+class Job:
+    planner: str
+    world: Path
+    out: Path
+
+    @property
+    def name(self) -> str:
+        return self.world.stem
+
+
+def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path) -> list[Path]:
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for family in families:
+        for s in range(seed, seed + count):
+            path = directory / f"{family}-{s}.yaml"
+            paths.append(dump_scenario(random_scenario(family, s), path))
+    return paths
+
+
+def run_job(job: Job, timeout: float) -> dict[str, Any]:
+    """One ``zenav run``; the run record, or an ``error`` record if the run failed."""
+    record_path = job.out / "run.json"
+    if record_path.exists():
+        record: dict[str, Any] = json.loads(record_path.read_text())
+        return record
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "zenav", "run", str(job.world), "--out", str(job.out),
+             "--planner", job.planner, "--log-level", "WARNING"],
+            capture_output=True, text=True, check=False, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"scenario": job.name, "planner": job.planner, "outcome": "error",
+                "error": f"no result within {timeout:.0f} s"}
+    if done.returncode != 0 or not record_path.exists():
+        return {"scenario": job.name, "planner": job.planner, "outcome": "error",
+                "error": (done.stderr.strip().splitlines() or ["?"])[-1]}
+    record = json.loads(record_path.read_text())
+    return record
+
+
+def run_all(jobs: list[Job], parallel: int, timeout: float,
+            on_done: Callable[[Job, dict[str, Any]], None]) -> list[tuple[Job, dict[str, Any]]]:
+    results: list[tuple[Job, dict[str, Any]]] = []
+    with ThreadPoolExecutor(max_workers=parallel) as pool:
+        futures = {pool.submit(run_job, job, timeout): job for job in jobs}
+        for future in as_completed(futures):
+            job = futures[future]
+            record = future.result()
+            results.append((job, record))
+            on_done(job, record)
+    return results
+
+
+@dataclass
+class PlannerSummary:
+    planner: str
+    runs: int
+    reached: int
+    collisions: int
+    timeouts: int
+    errors: int
+    mean_time: float  # on worlds every planner solved
+    mean_path: float
+    common: int  # how many such worlds
+    min_clearance: float  # worst over the runs that did not collide
+    median_clearance: float
+    decisions: float  # planner events per run
+
+    def rate(self, count: int) -> float:
+        return count / self.runs if self.runs else math.nan
+
+
+def family_of(name: str) -> str:
+    return name.rsplit("-", 1)[0]
+
+
+def summarise(records: list[dict[str, Any]], planners: Sequence[str]
+              ) -> tuple[list[PlannerSummary], dict[str, dict[str, float]]]:
+    by_planner: dict[str, list[dict[str, Any]]] = {p: [] for p in planners}
+    for r in records:
+        by_planner.setdefault(r["planner"], []).append(r)
+    worlds = {r["scenario"] for r in records}
+    solved_by_all = {w for w in worlds if all(
+        any(r["scenario"] == w and r["outcome"] == "reached" for r in by_planner[p])
+        for p in planners)}
+    summaries = []
+    for p in planners:
+        rs = by_planner[p]
+        common = [r for r in rs if r["scenario"] in solved_by_all and r["outcome"] == "reached"]
+        safe = [r["min_clearance"] for r in rs
+                if r["outcome"] != "collision" and r.get("min_clearance") is not None]
+        valid = [r for r in rs if r["outcome"] != "error"]
+        summaries.append(PlannerSummary(
+            planner=p, runs=len(valid),
+            reached=sum(r["outcome"] == "reached" for r in rs),
+            collisions=sum(r["outcome"] == "collision" for r in rs),
+            timeouts=sum(r["outcome"] == "timeout" for r in rs),
+            errors=sum(r["outcome"] == "error" for r in rs),
+            mean_time=statistics.fmean(r["time"] for r in common) if common else math.nan,
+            mean_path=statistics.fmean(r["path_length"] for r in common) if common else math.nan,
+            common=len(common),
+            min_clearance=min(safe) if safe else math.nan,
+            median_clearance=statistics.median(safe) if safe else math.nan,
+            decisions=statistics.fmean(len(r.get("events", [])) for r in valid) if valid
+            else math.nan,
+        ))
+    families: dict[str, dict[str, float]] = {}
+    for p in planners:
+        for r in by_planner[p]:
+            if r["outcome"] == "error":
+                continue
+            cell = families.setdefault(family_of(r["scenario"]), {})
+            cell[p + "/n"] = cell.get(p + "/n", 0) + 1
+            cell[p + "/ok"] = cell.get(p + "/ok", 0) + (r["outcome"] == "reached")
+            cell[p + "/hit"] = cell.get(p + "/hit", 0) + (r["outcome"] == "collision")
+    return summaries, families
+
+
+def pct(part: float, whole: float) -> str:
+    return "—" if not whole else f"{100 * part / whole:.0f} %"
+
+
+def num(value: float, digits: int = 1) -> str:
+    return "—" if math.isnan(value) else f"{value:.{digits}f}"
+
+
+def tables(summaries: list[PlannerSummary], families: dict[str, dict[str, float]]) -> str:
+    common = summaries[0].common if summaries else 0
+    lines = [
+        "| planner | runs | success | collision | timeout | mean time to goal s* | "
+        "mean path m* | min clearance m (worst / median) | decisions per run |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for s in summaries:
+        errors = f" (+{s.errors} failed)" if s.errors else ""
+        lines.append(
+            f"| {s.planner} | {s.runs}{errors} | {pct(s.reached, s.runs)} | "
+            f"{pct(s.collisions, s.runs)} | {pct(s.timeouts, s.runs)} | {num(s.mean_time)} | "
+            f"{num(s.mean_path, 2)} | {num(s.min_clearance, 3)} / {num(s.median_clearance, 3)} | "
+            f"{num(s.decisions)} |")
+    lines.append("")
+    lines.append(f"\\* on the {common} worlds every planner solved. Clearance over the runs "
+                 "without a collision.")
+    planners = [s.planner for s in summaries]
+    lines += ["", "| family | " + " | ".join(f"{p}: success (collisions)" for p in planners)
+              + " |", "|---|" + "---|" * len(planners)]
+    for family in FAMILIES:
+        if family not in families:
+            continue
+        cell = families[family]
+        lines.append(f"| {family} | " + " | ".join(
+            f"{pct(cell.get(p + '/ok', 0), cell.get(p + '/n', 0))} "
+            f"({int(cell.get(p + '/hit', 0))}/{int(cell.get(p + '/n', 0))})" for p in planners)
+            + " |")
+    return "\n".join(lines)
+
+
+def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, float]]) -> str:
+    paper = next((s for s in summaries if s.planner == "paper"), None)
+    if paper is None:
+        return ""
+    mixed = families.get("mixed", {})
+    n = mixed.get("paper/n", 0)
+    ok = mixed.get("paper/ok", 0)
+    hits = int(mixed.get("paper/hit", 0))
+    met = n > 0 and ok / n >= TARGET_MIXED_SUCCESS and hits == 0
+    others = [s for s in summaries if s.planner != "paper"]
+    ahead = all(paper.rate(paper.reached) > s.rate(s.reached) for s in others)
+    return (f"Goal: paper planner ≥ {100 * TARGET_MIXED_SUCCESS:.0f} % success and 0 collisions "
+            f"on the mixed set — measured {pct(ok, n)} and {hits} collisions in {int(n)} worlds "
+            f"({'met' if met else 'NOT met'}); ahead of every baseline on success rate: "
+            f"{paper.rate(paper.reached) * 100:.0f} % vs "
+            + ", ".join(f"{s.planner} {s.rate(s.reached) * 100:.0f} %" for s in others)
+            + f" ({'yes' if ahead else 'no'}).")
+
+
+def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
+         path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    planners = [s.planner for s in summaries]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.5))
+    bottom = [0.0] * len(planners)
+    for label, colour, values in (
+        ("reached", "#3a923a", [s.rate(s.reached) for s in summaries]),
+        ("timeout", "#e0a030", [s.rate(s.timeouts) for s in summaries]),
+        ("collision", "#c83737", [s.rate(s.collisions) for s in summaries]),
+    ):
+        shown = [0.0 if math.isnan(v) else 100 * v for v in values]
+        left.bar(planners, shown, bottom=bottom, color=colour, label=label)
+        bottom = [b + v for b, v in zip(bottom, shown, strict=True)]
+    left.set_ylabel("runs, %")
+    left.set_title("outcome per planner, all worlds")
+    left.legend(loc="lower right")
+    names = [f for f in FAMILIES if f in families]
+    width = 0.8 / max(len(planners), 1)
+    for i, p in enumerate(planners):
+        rates = []
+        for f in names:
+            n = families[f].get(p + "/n", 0)
+            rates.append(100 * families[f].get(p + "/ok", 0) / n if n else 0.0)
+        right.bar([k + i * width for k in range(len(names))], rates, width=width, label=p)
+    right.set_xticks([k + width * (len(planners) - 1) / 2 for k in range(len(names))])
+    right.set_xticklabels(names)
+    right.set_ylabel("success, %")
+    right.set_ylim(0, 105)
+    right.set_title("success per world family")
+    right.legend(loc="lower right", fontsize="small")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
+            families: Sequence[str] = FAMILIES, jobs: int = 2, timeout: float = 1800.0,
+            progress: bool = True, echo: Callable[[str], None] = print) -> str:
+    """Write the worlds, run every planner on each, print and write the report."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from zenav.services.runner import PLANNER_MODULES
+
+    unknown = [p for p in planners if p not in PLANNER_MODULES]
+    if unknown:
+        raise ValueError(f"unknown planner {', '.join(unknown)}; choose from "
+                         f"{', '.join(PLANNER_MODULES)}")
+    bad = [f for f in families if f not in FAMILIES]
+    if bad:
+        raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(FAMILIES)}")
+    out.mkdir(parents=True, exist_ok=True)
+    paths = write_worlds(families, worlds, seed, out / "worlds")
+    job_list = [Job(p, w, out / "runs" / p / w.stem) for w in paths for p in planners]
+    records: list[dict[str, Any]] = []
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), TimeRemainingColumn(), disable=not progress,
+                  transient=False) as bar:
+        task = bar.add_task("zenav bench nav", total=len(job_list))
+
+        def done(job: Job, record: dict[str, Any]) -> None:
+            records.append(record)
+            bar.update(task, advance=1, description=f"{job.planner} {job.name}: "
+                       f"{record['outcome']}")
+
+        run_all(job_list, jobs, timeout, done)
+    for r in records:
+        if r["outcome"] == "error":
+            echo(f"run failed: {r['planner']} {r['scenario']}: {r.get('error')}")
+    summaries, per_family = summarise(records, planners)
+    command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
+               f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
+                                   f" --families {','.join(families)}"))
+    report = (f"# zenav bench nav\n\n`{command}`\n\n"
+              f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
+              f"{len(paths)} worlds ({worlds} per family: {', '.join(families)}), "
+              f"{jobs} runs at a time\n\n{tables(summaries, per_family)}\n\n"
+              f"{goal_lines(summaries, per_family)}\n")
+    (out / "nav.md").write_text(report)
+    (out / "nav.json").write_text(json.dumps(
+        [{k: v for k, v in r.items() if k != "trajectory"} for r in records], indent=1))
+    plot(summaries, per_family, out / "nav.png")
+    echo(report)
+    echo(f"wrote {out / 'nav.md'}, {out / 'nav.png'}, {out / 'nav.json'}")
+    return report
