@@ -71,7 +71,7 @@ class Params(BaseModel):
     answer_timeout: float = Field(30.0, gt=0, description="wall s without an answer: fail")
     result_repeat: float = Field(0.5, gt=0, description="wall s between result repeats")
     realtime_history: float = Field(
-        600.0, gt=0, description="realtime: s of trajectory kept for the run result (a live "
+        60.0, gt=0, description="realtime: s of trajectory kept for the run result (a live "
         "stack runs for hours; lockstep runs keep every tick)"
     )
     base_timeout: float = Field(
