@@ -6,27 +6,30 @@ IEEE Robotics & Automation Magazine 4(1), 23–33, 1997.
 Each cycle searches the space of (v, ω) for circular arcs:
 
 1. **Dynamic window**: the velocities reachable within one control period from the
-   current ones, ``[v − v̇ Δt, v + v̇ Δt] × [ω − ω̇ Δt, ω + ω̇ Δt]``, cut to the robot's
-   limits, sampled ``vx_samples`` × ``vth_samples`` (ROS ``dwa_local_planner`` samples 3
-   × 20; more here, as the window is small at 10 Hz).
-2. **Forward simulation** of each arc for ``sim_time`` s in steps of
-   ``sim_granularity`` s (ROS: 1.7 s, 0.025 m; the paper: the arc itself), against the
-   scan's returns and the tracked movers at their predicted positions (the tracks'
-   velocities, so that DWA has the same knowledge of movers as the paper's planner;
-   scan returns on a mover are replaced by its prediction).
+   current ones (odometry), ``[v − v̇ Δt, v + v̇ Δt] × [ω − ω̇ Δt, ω + ω̇ Δt]``, cut to
+   the robot's limits, sampled ``vx_samples`` × ``vth_samples`` (ROS
+   ``dwa_local_planner`` samples 3 × 20; more here, as the window is small at 10 Hz),
+   plus ω = 0.
+2. **dist(v, ω)**: the arc length to the first contact on the arc's curvature v/ω,
+   followed out to ``dist_cap`` (the paper's "large constant" when nothing is on it)
+   every ``arc_step`` m against the scan's returns and the standing obstacles the
+   tracker remembers out of view; and the forward simulation of the arc for ``sim_time``
+   s (ROS: 1.7 s) against the tracked movers at their predicted positions (the tracks'
+   velocities: DWA gets the same knowledge of movers as the paper's planner; scan returns
+   on a mover are replaced by its prediction). Contact is the footprint plus
+   ``safety_margin``. Standing still follows no curvature: its dist is the clearance
+   where the robot stands.
 3. **Admissible velocities**: ``v ≤ sqrt(2 · dist(v, ω) · v̇_b)``, the robot can stop
    before the first contact on the arc.
 4. **Objective** ``G = α · heading + β · dist + γ · velocity``, each term in [0, 1]:
-   ``heading = 1 − |θ_goal − θ| / π`` at the end of the simulated arc (the paper scores
-   the pose after one period; implementations, like ROS's goal/path costs, score the end
-   of the rollout), ``dist`` the arc length to the first contact over ``dist_cap`` (the
-   paper's "large constant" when nothing is on the arc), ``velocity = v / v_max``. The
-   weights are the paper's, α = 2, β = 0.2, γ = 0.2: heading dominates and obstacles
-   act through admissibility and the distance term. The paper's smoothing of G over the
-   window is left out.
+   ``heading = 1 − |θ_goal − θ| / π`` at the pose after one control period (as the
+   paper), ``dist / dist_cap``, ``v / v_max``. The weights α = 2, β = 0.2, γ = 0.2 are
+   the values usually quoted for the paper's experiments. The paper's smoothing of G over
+   the window is left out.
 
 ``v_max`` is the mission's cruise speed, as every planner here is asked to cruise at it;
-the acceleration limits are the motor bridge's.
+the acceleration limits are the motor bridge's. With no admissible velocity the robot
+brakes as hard as the window allows.
 """
 
 from __future__ import annotations

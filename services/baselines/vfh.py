@@ -7,9 +7,10 @@ Three stages, as in the paper:
 
 1. **Histogram grid** (world frame, ``grid_cell`` = 10 cm cells) built by histogramic
    in-motion mapping (HIMM): each laser return adds ``increment`` (3) to the certainty
-   of its cell, each cell a beam passes through loses ``decrement`` (1); certainties stay
-   within [0, ``certainty_max``] (15). The grid remembers what left the 180° field of
-   view, as the paper's grid remembers what the sonars saw.
+   of its cell, each cell a beam crosses before its return (within the active window's
+   reach) loses ``decrement`` (1); certainties stay within [0, ``certainty_max``] (15).
+   The grid remembers what left the 180° field of view, as the paper's grid remembers
+   what the sonars saw.
 2. **Polar histogram** over the active window (``window_cells`` × ``window_cells``
    = 33 × 33 cells round the robot): each active cell adds ``m = c² (a − b d)`` to the
    sector (``sector_deg`` = 5°, 72 sectors) its direction falls in, with
