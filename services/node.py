@@ -281,11 +281,25 @@ class StampGate:
 
     ``check(stamp)`` answers ``"new"`` for a stamp later than any seen, ``"repeat"`` for
     the latest one again (a retransmission: answer it by republishing the last output),
-    and ``"old"`` for anything earlier (out of order: drop it).
+    and ``"old"`` for anything earlier (out of order: drop it). ``admit`` does all three
+    for a service whose output answers this input.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, node: Node | None = None, topic: Topic | None = None) -> None:
         self.last: float | None = None
+        self.node = node
+        self.topic = topic
+
+    def admit(self, stamp: float, output: TypedPublisher[Any]) -> bool:
+        """True for a new stamp; a repeat is answered with ``output``'s last message, an
+        earlier stamp is refused and counted (``out_of_order``)."""
+        order = self.check(stamp)
+        if order == "repeat":
+            output.republish()
+        elif order == "old" and self.node is not None and self.topic is not None:
+            self.node.reject(self.node.keys.of(self.topic), "out_of_order",
+                             f"stamp {stamp} after {self.last}")
+        return order == "new"
 
     def check(self, stamp: float) -> str:
         if self.last is None or stamp > self.last:

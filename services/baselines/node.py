@@ -80,7 +80,7 @@ class BaselineService:
         self.commands = node.publisher(keys.CMD_VEL, VelocityCommand, urgent=True)
         self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.TRACKS)
         self.scans: dict[float, LaserScan] = {}
         self.odometry: dict[float, Odometry] = {}
         self.last_action: Action | None = None
@@ -113,13 +113,7 @@ class BaselineService:
                      movers=movers, remembered=remembered)
 
     def on_tracks(self, tracks: TrackList) -> None:
-        order = self.gate.check(tracks.stamp)
-        if order == "repeat":
-            self.commands.republish()
-            return
-        if order == "old":
-            self.node.reject(self.node.keys.of(keys.TRACKS), "out_of_order",
-                             f"tracks stamped {tracks.stamp} after {self.gate.last}")
+        if not self.gate.admit(tracks.stamp, self.commands):
             return
         at = latest_at(self.scans, tracks.stamp)
         v = omega = 0.0

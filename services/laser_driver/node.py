@@ -78,23 +78,16 @@ class Service:
         self.node = node
         self.params = params
         self.scans = node.publisher(keys.SCAN, LaserScan)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.RAW_LASER)
         node.subscribe(keys.RAW_LASER, RawLaserFrame, self.on_frame, depth=2)
 
     def on_frame(self, frame: RawLaserFrame) -> None:
-        key = self.node.keys.of(keys.RAW_LASER)
         try:  # checked before the stamp order: a bad frame must not pass as a repeat
             scan = frame_to_scan(frame, self.params, seq=0)
         except FrameError as exc:
-            self.node.reject(key, "bad_frame", str(exc))
+            self.node.reject(self.node.keys.of(keys.RAW_LASER), "bad_frame", str(exc))
             return
-        order = self.gate.check(frame.stamp)
-        if order == "repeat":
-            self.scans.republish()
-            return
-        if order == "old":
-            self.node.reject(key, "out_of_order",
-                             f"frame stamped {frame.stamp} after {self.gate.last}")
+        if not self.gate.admit(frame.stamp, self.scans):
             return
         self.scans.publish(scan.model_copy(update={"seq": self.scans.next_seq()}))
 

@@ -122,7 +122,7 @@ class Service:
         self.filter = CommandFilter(params)
         self.limiter = self.filter.limiter
         self.base = node.publisher(keys.BASE_CMD, BaseCommand, reliable=True, urgent=True)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.CMD_VEL)
         self.now: float | None = None  # latest stamp seen: the stack's clock
         self.last_command_stamp: float | None = None
         self.last_command_wall = time.monotonic()
@@ -146,13 +146,7 @@ class Service:
         return self.scans[max(earlier)] if earlier else None
 
     def on_command(self, command: VelocityCommand) -> None:
-        order = self.gate.check(command.stamp)
-        if order == "repeat":
-            self.base.republish()
-            return
-        if order == "old":
-            self.node.reject(self.node.keys.of(keys.CMD_VEL), "out_of_order",
-                             f"command stamped {command.stamp} after {self.gate.last}")
+        if not self.gate.admit(command.stamp, self.base):
             return
         if self.stopped_for_staleness:
             log.info("commands resumed at t=%.3f", command.stamp)

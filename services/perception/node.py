@@ -65,7 +65,7 @@ class Service:
         self.node = node
         self.params = params
         self.chains = node.publisher(keys.OBSTACLES, ObstacleChain)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.SCAN)
         self.history = PoseHistory()
         self.waiting: LaserScan | None = None
         self.perceiver = Perceiver(params)
@@ -81,16 +81,7 @@ class Service:
                 self.process(scan, pose)
 
     def on_scan(self, scan: LaserScan) -> None:
-        order = self.gate.check(scan.stamp)
-        if order == "repeat":
-            self.chains.republish()
-            return
-        if order == "old":
-            self.node.reject(
-                self.node.keys.of(keys.SCAN),
-                "out_of_order",
-                f"scan stamped {scan.stamp} after {self.gate.last}",
-            )
+        if not self.gate.admit(scan.stamp, self.chains):
             return
         pose = self.history.at(scan.stamp)
         if pose is not None:

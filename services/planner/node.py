@@ -90,17 +90,11 @@ class Service:
         self.history: deque[bytes] = deque(maxlen=EVENTS_KEPT)
         node.bus.declare_queryable(node.keys.of(keys.EVENT_HISTORY), lambda: list(self.history))
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.TRACKS)
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
 
     def on_tracks(self, tracks: TrackList) -> None:
-        order = self.gate.check(tracks.stamp)
-        if order == "repeat":
-            self.commands.republish()
-            return
-        if order == "old":
-            self.node.reject(self.node.keys.of(keys.TRACKS), "out_of_order",
-                             f"tracks stamped {tracks.stamp} after {self.gate.last}")
+        if not self.gate.admit(tracks.stamp, self.commands):
             return
         pose = tracks.pose
         decision = self.planner.step((pose.x, pose.y, pose.heading), obstacles_of(tracks),

@@ -41,20 +41,11 @@ class Service:
         self.node = node
         self.tracker = Tracker(params)
         self.tracks = node.publisher(keys.TRACKS, TrackList)
-        self.gate = StampGate()
+        self.gate = StampGate(node, keys.OBSTACLES)
         node.subscribe(keys.OBSTACLES, ObstacleChain, self.on_chain, depth=2)
 
     def on_chain(self, chain: ObstacleChain) -> None:
-        order = self.gate.check(chain.stamp)
-        if order == "repeat":
-            self.tracks.republish()
-            return
-        if order == "old":
-            self.node.reject(
-                self.node.keys.of(keys.OBSTACLES),
-                "out_of_order",
-                f"chain stamped {chain.stamp} after {self.gate.last}",
-            )
+        if not self.gate.admit(chain.stamp, self.tracks):
             return
         clusters = from_message(chain)
         states = self.tracker.update(chain.stamp, clusters.pose, clusters)
