@@ -22,7 +22,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level)
     except (ScenarioError, ConfigError) as exc:
-        print(f"zenav run: {exc}", file=sys.stderr)
+        # one line, every problem in it: "file: field: problem; file: field: problem"
+        print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
     except RunError as exc:
         print(f"zenav run: {exc}", file=sys.stderr)
