@@ -296,16 +296,12 @@ async def replay(transport: Any, path: Path, *, rate: float, topics: set[str] | 
 
 
 def record_main(args: argparse.Namespace) -> int:
-    from zenav.schemas.keys import check_robot_id
-    from zenav.services.config import ConfigError
-    from zenav.tooling import tool_transport
+    from zenav.tooling import tool_setup
 
-    try:
-        robot_id = check_robot_id(args.robot_id)
-        transport = tool_transport(args)
-    except (ConfigError, ValueError) as exc:
-        print(f"zenav record: {exc}", file=sys.stderr)
+    setup = tool_setup(args, "record")
+    if setup is None:
         return 2
+    robot_id, transport = setup
     started = time.monotonic()
     with contextlib.suppress(KeyboardInterrupt):
         count, changes = asyncio.run(record(transport, robot_id, args.file,

@@ -487,16 +487,12 @@ async def _wait(stop: asyncio.Event, period: float) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from zenav.schemas.keys import check_robot_id
-    from zenav.services.config import ConfigError
-    from zenav.tooling import tool_transport
+    from zenav.tooling import tool_setup
 
-    try:
-        robot_id = check_robot_id(args.robot_id)
-        transport = tool_transport(args)
-    except (ConfigError, ValueError) as exc:
-        print(f"zenav monitor: {exc}", file=sys.stderr)
+    setup = tool_setup(args, "monitor")
+    if setup is None:
         return 2
+    robot_id, transport = setup
     with contextlib.suppress(KeyboardInterrupt):
         asyncio.run(monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
                             duration=args.duration, silence=args.silence))

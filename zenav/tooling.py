@@ -13,6 +13,7 @@ import asyncio
 import contextlib
 import logging
 import signal
+import sys
 import time
 from collections.abc import Callable
 from typing import Any
@@ -50,6 +51,19 @@ def tool_transport(args: argparse.Namespace) -> TransportConfig:
     if args.connect and args.mode is None and args.transport is None:
         return client_transport(list(args.connect))
     return with_client_defaults(transport_from_args(args, None))
+
+
+def tool_setup(args: argparse.Namespace, command: str) -> tuple[str, TransportConfig] | None:
+    """(robot id, transport) of a tool from its options; None after printing the reason
+    (the tool then exits with status 2)."""
+    from zenav.schemas.keys import check_robot_id
+    from zenav.services.config import ConfigError
+
+    try:
+        return check_robot_id(args.robot_id), tool_transport(args)
+    except (ConfigError, ValueError) as exc:
+        print(f"zenav {command}: {exc}", file=sys.stderr)
+        return None
 
 
 def stop_on_signals(stop: asyncio.Event) -> None:

@@ -32,11 +32,11 @@ from pydantic import Field
 from zenav.services.baselines.common import (
     Cycle,
     FloatArray,
-    MissionParams,
     returns,
     world_points,
     wrap,
 )
+from zenav.services.planner.params import MissionParams
 
 
 class Params(MissionParams):

@@ -14,37 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
-from pydantic import BaseModel, ConfigDict, Field
 
 FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
-
-
-class MissionParams(BaseModel):
-    """The mission fields ``zenav run`` hands every planner (see ``zenav.run.stack_params``).
-
-    ``start`` and ``cell`` are accepted so that any planner runs under the same
-    parameters; the baselines do not use them (they have no global path and keep their
-    own grids).
-    """
-
-    model_config = ConfigDict(extra="forbid")
-
-    goal: tuple[float, float] = Field((6.0, 0.0), description="global target, m")
-    start: tuple[float, float] | None = Field(
-        None, description="start of the global path, m (accepted, unused by the baselines)"
-    )
-    goal_tolerance: float = Field(0.25, gt=0, description="arrived within this distance, m")
-    cruise_speed: float = Field(0.1, gt=0, description="V_R: top speed the planner asks for, m/s")
-    max_speed: float = Field(0.2, gt=0, description="top speed of the base, m/s")
-    robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
-    cell: float = Field(0.5, gt=0, description="the paper's grid r, m (accepted, unused)")
-    window_radius: float = Field(4.0, gt=0, description="returns farther than this are "
-                                 "ignored, m")
-    max_omega: float = Field(1.0, gt=0, description="turn rate limit, rad/s (as the paper "
-                             "planner's)")
-    moving_speed: float = Field(0.03, ge=0, description="tracks slower than this count as "
-                                "standing still, m/s")
 
 
 @dataclass(frozen=True)

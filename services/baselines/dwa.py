@@ -44,11 +44,11 @@ from scipy.spatial import cKDTree
 from zenav.services.baselines.common import (
     Cycle,
     FloatArray,
-    MissionParams,
     disc_points,
     returns,
     world_points,
 )
+from zenav.services.planner.params import MissionParams
 
 
 class Params(MissionParams):

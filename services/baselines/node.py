@@ -27,8 +27,9 @@ from zenav.schemas.messages import (
     TrackList,
     VelocityCommand,
 )
-from zenav.services.baselines.common import Cycle, MissionParams, Obstacles, goal_reached
+from zenav.services.baselines.common import Cycle, Obstacles, goal_reached
 from zenav.services.node import Node, StampGate
+from zenav.services.planner.params import MissionParams
 
 KEPT = 8
 """Scans and odometry messages kept by stamp."""

@@ -42,7 +42,8 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import Field, model_validator
 
-from zenav.services.baselines.common import Cycle, FloatArray, MissionParams, returns, wrap
+from zenav.services.baselines.common import Cycle, FloatArray, returns, wrap
+from zenav.services.planner.params import MissionParams
 
 IntArray = npt.NDArray[np.int64]
 

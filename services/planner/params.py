@@ -5,7 +5,10 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field
 
 
-class Params(BaseModel):
+class MissionParams(BaseModel):
+    """What every planner implementation is given (``zenav run`` fills it from the
+    scenario): the mission, the robot and the world grid."""
+
     model_config = ConfigDict(extra="forbid")
 
     # --- the mission ----------------------------------------------------------------
@@ -19,12 +22,20 @@ class Params(BaseModel):
     cruise_speed: float = Field(0.1, gt=0, description="V_R, m/s")
     max_speed: float = Field(0.2, gt=0, description="top speed when speeding up, m/s")
     robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
-    heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of heading error, 1/s")
     max_omega: float = Field(1.0, gt=0, description="turn rate limit, rad/s")
 
     # --- the world model ------------------------------------------------------------
     cell: float = Field(0.5, gt=0, description="grid resolution r, m (Eq. 2)")
     window_radius: float = Field(4.0, gt=0, description="r_w: obstacles beyond are ignored, m")
+    moving_speed: float = Field(
+        0.03, ge=0, description="tracks slower than this are treated as standing still, m/s"
+    )
+
+
+class Params(MissionParams):
+    """The paper planner's parameters."""
+
+    heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of heading error, 1/s")
     safety_margin: float = Field(
         0.1, ge=0, description="gap kept between footprints on top of both radii, m"
     )
@@ -37,9 +48,6 @@ class Params(BaseModel):
     horizon: float = Field(
         12.0, gt=0, description="longest time ahead a meeting with a mover is acted on, s: "
         "velocity errors grow with it, and the robot has time to answer a later one later"
-    )
-    moving_speed: float = Field(
-        0.03, ge=0, description="tracks slower than this are treated as standing still, m/s"
     )
     head_on_cos: float = Field(
         -0.8, description="cos of the angle between motions below which a mover is head-on (f)"
