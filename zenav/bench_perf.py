@@ -51,9 +51,10 @@ from zenav.schemas import keys
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Pose2D, RawLaserFrame, TrackList
 from zenav.services.config import loopback_mesh
+from zenav.sim import SCENARIO_DIR
 from zenav.sim.scenario import Scenario, load_scenario, parse_scenario
 
-SCENARIOS = Path(__file__).resolve().parent / "sim" / "scenarios"
+SCENARIOS = SCENARIO_DIR
 PAPER_SCENARIOS = tuple(sorted(SCENARIOS.glob("[a-h]-*.yaml")))
 
 TARGET_PIPELINE_MEDIAN_US = 500.0  # whole pipeline, 5 obstacles in view

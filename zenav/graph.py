@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-from pathlib import Path
 from typing import Any
 
 import yaml
@@ -25,6 +24,7 @@ from zenav.schemas.messages import ALL_MESSAGES, Message
 from zenav.services.config import SERVICE_ORDER
 from zenav.services.node import Handler, M, Node, TypedPublisher
 from zenav.services.transport import InMemoryBus, LivelinessCallback, Snapshot, Subscription
+from zenav.sim import SCENARIO_DIR
 
 PROBE_ROBOT = "graph"
 
@@ -32,7 +32,7 @@ KNOWN_TOPICS: dict[str, type[Message]] = {
     t.name: t.message for t in vars(keys).values() if isinstance(t, Topic)}
 """Every topic schemas/keys.py defines, with its message type."""
 
-SCENARIO = Path(__file__).resolve().parent / "sim" / "scenarios" / "a-no-obstacle.yaml"
+SCENARIO = SCENARIO_DIR / "a-no-obstacle.yaml"
 """The simulator needs a scenario to be built; any will do."""
 
 

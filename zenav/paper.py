@@ -22,9 +22,8 @@ import numpy as np
 import yaml
 
 from zenav.run import run_scenario
+from zenav.sim import SCENARIO_DIR
 from zenav.sim.scenario import Scenario, load_scenario
-
-SCENARIO_DIR = Path(__file__).resolve().parent / "sim" / "scenarios"
 
 PAPER_TIMES: dict[str, tuple[float, float, float, float]] = {
     "a": (61.77, 62.00, 61.98, 61.92),
