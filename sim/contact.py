@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .raycast import box_entry_time, circle_entry_time
-from .world import World, WorldSnapshot
+from zenav.sim.raycast import box_entry_time, circle_entry_time
+from zenav.sim.world import World, WorldSnapshot
 
 __all__ = ["clearance", "clearances", "first_contact"]
 

@@ -1,4 +1,5 @@
-"""Unicycle (differential-drive) robot kinematics and velocity limits.
+"""Unicycle (differential-drive) robot kinematics (angle wrap and velocity limits:
+:mod:`zenav.services.geometry`).
 
 Positions in m, headings in rad from +x counter-clockwise, wrapped to (-pi, pi];
 linear speed v in m/s, turn rate omega in rad/s, time in s.
@@ -9,7 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["RobotState", "limit_velocity", "step_robot", "unicycle_step", "wrap_angle"]
+from zenav.services.geometry import limit_velocity, wrap_angle
+
+__all__ = ["RobotState", "step_robot", "unicycle_step"]
 
 
 @dataclass
@@ -21,12 +24,6 @@ class RobotState:
     heading: float
     v: float = 0.0
     omega: float = 0.0
-
-
-def wrap_angle(angle: float) -> float:
-    """The same angle (rad) in (-pi, pi]."""
-    wrapped = math.remainder(angle, 2.0 * math.pi)  # in [-pi, pi]
-    return wrapped + 2.0 * math.pi if wrapped <= -math.pi else wrapped
 
 
 def unicycle_step(
@@ -49,35 +46,6 @@ def unicycle_step(
         y + chord * math.sin(direction),
         wrap_angle(heading + omega * dt),
     )
-
-
-def limit_velocity(
-    v_current: float,
-    v_target: float,
-    accel_limit: float,
-    decel_limit: float,
-    dt: float,
-    v_max: float,
-) -> float:
-    """The velocity reached after ``dt`` (s) when asking for ``v_target``.
-
-    Works the same for linear (m/s, m/s^2) and angular (rad/s, rad/s^2) velocity.
-    The target is clamped to [-v_max, v_max]; then the change is limited to
-    ``accel_limit * dt`` when speeding up (|target| >= |current|, same sign) and
-    to ``decel_limit * dt`` otherwise (slowing down or reversing), as in Nav2's
-    velocity smoother. Limits are magnitudes (>= 0; ``math.inf`` means no limit).
-    """
-    if accel_limit < 0.0 or decel_limit < 0.0 or dt < 0.0 or v_max < 0.0:
-        raise ValueError(
-            "accel_limit, decel_limit, dt and v_max must be >= 0 "
-            f"(got {accel_limit}, {decel_limit}, {dt}, {v_max})"
-        )
-    target = min(max(v_target, -v_max), v_max)
-    speeding_up = abs(target) >= abs(v_current) and target * v_current >= 0.0
-    limit = accel_limit if speeding_up else decel_limit
-    max_change = limit * dt if dt > 0.0 else 0.0
-    change = min(max(target - v_current, -max_change), max_change)
-    return v_current + change
 
 
 def step_robot(

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 if TYPE_CHECKING:
-    from .world import WorldSnapshot
+    from zenav.sim.world import WorldSnapshot
 
 __all__ = ["box_entry_time", "cast_rays", "circle_entry_time", "simulate_scan"]
 

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import DTypeLike, NDArray
 
-from .scenario import Scenario
+from zenav.sim.scenario import Scenario
 
 __all__ = ["World", "WorldSnapshot"]
 

@@ -34,8 +34,8 @@ from zenav.services.baselines.common import (
     FloatArray,
     returns,
     world_points,
-    wrap,
 )
+from zenav.services.geometry import wrap_angle
 from zenav.services.planner.params import MissionParams
 
 
@@ -113,7 +113,7 @@ class APF:
         size = float(np.hypot(*total))
         if size < 1e-9:
             return Decision(0.0, 0.0, (0.0, 0.0), (float(repulse[0]), float(repulse[1])), count)
-        angle = wrap(math.atan2(total[1], total[0]) - cycle.pose[2])
+        angle = wrap_angle(math.atan2(total[1], total[0]) - cycle.pose[2])
         omega = max(-p.max_omega, min(p.max_omega, p.heading_gain * angle))
         v = min(p.cruise_speed, size) * max(0.0, math.cos(angle))
         return Decision(v, omega, (float(total[0]), float(total[1])),

@@ -45,11 +45,6 @@ class Cycle:
     remembered: Obstacles = field(default_factory=Obstacles)  # standing tracks out of view
 
 
-def wrap(angle: float) -> float:
-    """Angle in [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
-
-
 def returns(cycle: Cycle, reach: float) -> BoolArray:
     """Beams with a return within ``reach`` m."""
     return (cycle.ranges < cycle.range_max * 0.999) & (cycle.ranges <= reach)

@@ -48,6 +48,7 @@ from zenav.services.baselines.common import (
     returns,
     world_points,
 )
+from zenav.services.geometry import wrap_angles
 from zenav.services.planner.params import MissionParams
 
 
@@ -167,8 +168,7 @@ def plan(cycle: Cycle, p: Params) -> Decision:
 
     gx, gy = cycle.goal
     end_x, end_y, end_theta = px[:, 0], py[:, 0], theta[:, 0]  # after one period
-    error = np.abs((np.arctan2(gy - end_y, gx - end_x) - end_theta + math.pi)
-                   % (2 * math.pi) - math.pi)
+    error = np.abs(wrap_angles(np.arctan2(gy - end_y, gx - end_x) - end_theta))
     score = (p.alpha * (1.0 - error / math.pi)
              + p.beta * np.minimum(dist, p.dist_cap) / p.dist_cap
              + p.gamma * v / p.v_max)

@@ -42,7 +42,8 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import Field, model_validator
 
-from zenav.services.baselines.common import Cycle, FloatArray, returns, wrap
+from zenav.services.baselines.common import Cycle, FloatArray, returns
+from zenav.services.geometry import wrap_angle, wrap_positive
 from zenav.services.planner.params import MissionParams
 
 IntArray = npt.NDArray[np.int64]
@@ -171,7 +172,7 @@ class HistogramGrid:
         dx, dy = cx - x, cy - y
         d = np.hypot(dx, dy)
         m = certainty**2 * np.maximum(p.a - p.b * d, 0.0)
-        beta = np.arctan2(dy, dx) % (2 * math.pi)
+        beta = wrap_positive(np.arctan2(dy, dx))
         k = np.minimum((beta / math.radians(p.sector_deg)).astype(np.int64), p.sectors - 1)
         return np.bincount(k, weights=m, minlength=p.sectors).astype(np.float64)
 
@@ -219,18 +220,17 @@ def steer(valley_list: list[Valley], target: float, sector: float, s_max: int,
     border). The candidate nearest the ``previous`` direction is kept unless another is
     nearer the target by more than ``keep_margin`` rad.
     """
-    two_pi = 2 * math.pi
     margin = s_max * sector / 2
     found: list[tuple[float, float, float]] = []  # distance to the target, -width, direction
     for v in valley_list:
         lo = v.start * sector
         width = v.width * sector
-        if width >= two_pi - 1e-9:
+        if width >= 2 * math.pi - 1e-9:
             return target
-        to_lo = (lo - target) % two_pi  # counter-clockwise from the target to the border
-        to_hi = (target - (lo + width)) % two_pi  # clockwise to the other border
-        if (target - lo) % two_pi < width:  # the target is in the valley
-            offset = (target - lo) % two_pi
+        to_lo = wrap_positive(lo - target)  # counter-clockwise from the target to the border
+        to_hi = wrap_positive(target - (lo + width))  # clockwise to the other border
+        if wrap_positive(target - lo) < width:  # the target is in the valley
+            offset = wrap_positive(target - lo)
             if v.width > s_max:  # wide: straight on, but s_max/2 clear of the borders
                 found.append((0.0, -width, lo + min(max(offset, margin), width - margin)))
             else:
@@ -246,10 +246,10 @@ def steer(valley_list: list[Valley], target: float, sector: float, s_max: int,
         return None
     best = min(found, key=lambda f: f[:2])
     if previous is not None:
-        held = min(found, key=lambda f: abs(wrap(f[2] - previous)))
+        held = min(found, key=lambda f: abs(wrap_angle(f[2] - previous)))
         if held[0] <= best[0] + keep_margin:
-            return held[2] % two_pi
-    return best[2] % two_pi
+            return wrap_positive(held[2])
+    return wrap_positive(best[2])
 
 
 @dataclass(frozen=True)
@@ -274,16 +274,17 @@ class VFH:
         self.grid.update(cycle)
         h = smooth(self.grid.polar_histogram(x, y), p.smoothing)
         sector = math.radians(p.sector_deg)
-        target = math.atan2(cycle.goal[1] - y, cycle.goal[0] - x) % (2 * math.pi)
+        target = wrap_positive(math.atan2(cycle.goal[1] - y, cycle.goal[0] - x))
         direction = steer(valleys(h < p.threshold), target, sector, p.s_max, self.previous,
                           math.radians(p.keep_valley_deg))
         self.previous = direction
-        ahead = float(h[int((heading % (2 * math.pi)) / sector) % p.sectors])
+        ahead = float(h[int(wrap_positive(heading) / sector) % p.sectors])
         if direction is None:
             emptiest = (int(np.argmin(h)) + 0.5) * sector
-            omega = math.copysign(p.max_omega, wrap(emptiest - heading))
+            omega = math.copysign(p.max_omega, wrap_angle(emptiest - heading))
             return Decision(0.0, omega, None, ahead)
-        omega = max(-p.max_omega, min(p.max_omega, p.heading_gain * wrap(direction - heading)))
+        turn = p.heading_gain * wrap_angle(direction - heading)
+        omega = max(-p.max_omega, min(p.max_omega, turn))
         v_prime = p.cruise_speed * (1.0 - min(ahead, p.h_m) / p.h_m)
         v = v_prime * (1.0 - abs(omega) / p.max_omega) + p.v_min
         distance = math.hypot(cycle.goal[0] - x, cycle.goal[1] - y)

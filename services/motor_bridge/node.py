@@ -18,9 +18,9 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCommand
+from zenav.services.geometry import limit_velocity
 from zenav.services.motor_bridge.stop_zone import stop_distance, zone_blocked
 from zenav.services.node import Node, StampGate
-from zenav.sim.kinematics import limit_velocity
 
 log = logging.getLogger(__name__)
 

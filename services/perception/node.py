@@ -14,12 +14,12 @@ from collections import deque
 
 from zenav.schemas import keys
 from zenav.schemas.messages import LaserScan, ObstacleChain, Odometry
+from zenav.services.geometry import wrap_angle
 from zenav.services.node import Node, StampGate
 from zenav.services.perception.clustering import Pose
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
 from zenav.services.perception.wire import to_message
-from zenav.sim.kinematics import wrap_angle
 
 Params = PerceptionParams
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from zenav.sim.kinematics import wrap_angle
+from zenav.services.geometry import wrap_angle
 
 
 def command_toward(

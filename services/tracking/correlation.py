@@ -33,6 +33,8 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.geometry import wrap_degrees
+
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 Kind = Literal["new", "static", "dynamic"]
@@ -226,12 +228,6 @@ class Motion:
     heading: float
     vx: float
     vy: float
-
-
-def wrap_degrees(angle_deg: float) -> float:
-    """An angle in degrees wrapped to [0, 360)."""
-    a = angle_deg % 360.0
-    return 0.0 if a >= 360.0 else a  # -1e-17 % 360 rounds to 360.0
 
 
 def alpha_o_from_heading(heading: float) -> float:

@@ -8,7 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from zenav.sim.kinematics import RobotState, limit_velocity, step_robot, unicycle_step, wrap_angle
+from zenav.services.geometry import limit_velocity, wrap_angle
+from zenav.sim.kinematics import RobotState, step_robot, unicycle_step
 
 
 def test_straight_line_along_the_heading() -> None:

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from zenav.services.geometry import wrap_degrees
 from zenav.services.tracking.correlation import (
     alpha_o_from_heading,
     best_match,
@@ -22,7 +23,6 @@ from zenav.services.tracking.correlation import (
     overlap_cells,
     spatial_correlation,
     union_cells,
-    wrap_degrees,
 )
 
 CELL = 0.5
