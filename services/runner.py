@@ -1,10 +1,12 @@
 """Start one service as its own process: ``zenav service NAME`` or ``python -m ...``.
 
-Each service module defines ``Params`` (a pydantic model with every default) and
-``Service``, built as ``Service(node, params)``. A service with work of its own (the
-simulator's clock, the motor bridge's watchdog) has ``async def run()``; when ``run``
-returns, the process stops. SIGINT and SIGTERM stop it cleanly: inputs cancelled,
-liveliness token and declarations undeclared, session closed.
+Every service folder has the same shape: ``params.py`` (the pydantic model with every
+default), pure modules, and a thin ``node.py`` with ``Service``, built as
+``Service(node, params)``; :data:`SERVICES` and :data:`PLANNERS` say where each lives.
+A service with work of its own (the simulator's clock, the motor bridge's watchdog)
+has ``async def run()``; when ``run`` returns, the process stops. SIGINT and SIGTERM
+stop it cleanly: inputs cancelled, liveliness token and declarations undeclared,
+session closed.
 """
 
 from __future__ import annotations
@@ -17,8 +19,9 @@ import logging
 import signal
 import sys
 from pathlib import Path
-from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
+
+from pydantic import BaseModel
 
 from zenav.schemas.keys import Keys, check_robot_id
 from zenav.services.config import (
@@ -34,35 +37,80 @@ from zenav.services.transport import Bus, TransportConfig, ZenohBus
 
 log = logging.getLogger(__name__)
 
-SERVICE_MODULES: dict[str, str] = {
-    "simulator": "zenav.sim.node",
-    "laser_driver": "zenav.services.laser_driver.node",
-    "perception": "zenav.services.perception.node",
-    "tracking": "zenav.services.tracking.node",
-    "planner": "zenav.services.planner.node",
-    "motor_bridge": "zenav.services.motor_bridge.node",
-}
-assert tuple(SERVICE_MODULES) == SERVICE_ORDER
+class Where(NamedTuple):
+    """Where a service's parameter model and its service class are ("module:Class")."""
 
-PLANNER_MODULES: dict[str, str] = {
-    "paper": "zenav.services.planner.node",
-    "vfh": "zenav.services.baselines.vfh_node",
-    "dwa": "zenav.services.baselines.dwa_node",
-    "apf": "zenav.services.baselines.apf_node",
+    params: str
+    service: str
+
+
+PLANNERS: dict[str, Where] = {
+    "paper": Where("zenav.services.planner.params:Params", "zenav.services.planner.node:Service"),
+    "vfh": Where("zenav.services.baselines.params:VFHParams",
+                 "zenav.services.baselines.node:VFHService"),
+    "dwa": Where("zenav.services.baselines.params:DWAParams",
+                 "zenav.services.baselines.node:DWAService"),
+    "apf": Where("zenav.services.baselines.params:APFParams",
+                 "zenav.services.baselines.node:APFService"),
 }
 """Planner implementations: each reads the same inputs and publishes the same outputs
 as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""
 
+PLANNER_MODULES = PLANNERS
+"""The old name of :data:`PLANNERS` (zenav/bench_nav.py reads it)."""
 
-def service_module(name: str, planner: str = "paper") -> ModuleType:
-    if name not in SERVICE_MODULES:
+SERVICES: dict[str, Where] = {
+    "simulator": Where("zenav.sim.params:Params", "zenav.sim.node:Service"),
+    "laser_driver": Where("zenav.services.laser_driver.params:Params",
+                          "zenav.services.laser_driver.node:Service"),
+    "perception": Where("zenav.services.perception.params:PerceptionParams",
+                        "zenav.services.perception.node:Service"),
+    "tracking": Where("zenav.services.tracking.params:TrackingParams",
+                      "zenav.services.tracking.node:Service"),
+    "planner": PLANNERS["paper"],
+    "motor_bridge": Where("zenav.services.motor_bridge.params:Params",
+                          "zenav.services.motor_bridge.node:Service"),
+}
+assert tuple(SERVICES) == SERVICE_ORDER
+
+
+class Implementation(NamedTuple):
+    """A service's parameter model and its class (``Service(node, params)``)."""
+
+    Params: type[BaseModel]
+    Service: type[Any]
+
+
+def _where(name: str, planner: str = "paper") -> Where:
+    if name not in SERVICES:
         raise ConfigError(f"no service named {name!r}; the services are {', '.join(SERVICE_ORDER)}")
     if name == "planner":
-        if planner not in PLANNER_MODULES:
+        if planner not in PLANNERS:
             raise ConfigError(f"no planner named {planner!r}; the planners are "
-                              f"{', '.join(PLANNER_MODULES)}")
-        return importlib.import_module(PLANNER_MODULES[planner])
-    return importlib.import_module(SERVICE_MODULES[name])
+                              f"{', '.join(PLANNERS)}")
+        return PLANNERS[planner]
+    return SERVICES[name]
+
+
+def _load(spec: str) -> Any:
+    module, _, attribute = spec.partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+def service_params(name: str, planner: str = "paper") -> type[BaseModel]:
+    """The parameter model of a service (without importing its node); ConfigError if none."""
+    model: type[BaseModel] = _load(_where(name, planner).params)
+    return model
+
+
+def implementation(name: str, planner: str = "paper") -> Implementation:
+    """The parameter model and the service class of a service; ConfigError if none."""
+    where = _where(name, planner)
+    return Implementation(_load(where.params), _load(where.service))
+
+
+service_module = implementation
+"""The old name of :func:`implementation` (zenav/graph.py calls it)."""
 
 
 def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
@@ -107,9 +155,8 @@ def setup_logging(level: str, name: str) -> None:
 
 async def serve(name: str, bus: Bus, keys: Keys, params: Any, planner: str = "paper") -> None:
     """Build the service on ``bus`` and run it until stopped or until its run() ends."""
-    module = service_module(name, planner)
     node = Node(name, bus, keys)
-    service = module.Service(node, params)
+    service = implementation(name, planner).Service(node, params)
     loop = asyncio.get_running_loop()
     for signum in (signal.SIGINT, signal.SIGTERM):
         with contextlib.suppress(NotImplementedError, RuntimeError):  # not the main thread
@@ -146,14 +193,13 @@ def main(name: str, argv: list[str] | None = None) -> int:
     parser.add_argument("--log-level", default="INFO")
     if name == "planner":
         parser.add_argument("--planner", default="paper",
-                            help=f"implementation: {', '.join(PLANNER_MODULES)} (default paper)")
+                            help=f"implementation: {', '.join(PLANNERS)} (default paper)")
     add_transport_arguments(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
     try:
         planner = getattr(args, "planner", "paper")
-        module = service_module(name, planner)
-        params = load_params(module.Params, args.config, args.set)
+        params = load_params(service_params(name, planner), args.config, args.set)
         keys = Keys(check_robot_id(args.robot_id))
         transport = transport_from_args(args, name)
     except (ConfigError, ValueError) as exc:

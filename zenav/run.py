@@ -22,37 +22,18 @@ from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
 from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
-from zenav.services.runner import PLANNER_MODULES
+from zenav.services.mission import stack_params
+from zenav.services.runner import PLANNERS
 from zenav.services.transport import ZenohBus
-from zenav.sim.scenario import Scenario, load_scenario
+from zenav.sim.scenario import load_scenario
+
+__all__ = ["RunError", "apply_override", "make_record", "run_scenario", "stack_params"]
+# stack_params lives in zenav.services.mission; zenav/inprocess.py, soak.py, deploy and
+# bench still import it from here.
 
 
 class RunError(RuntimeError):
     """The run could not be made; the message is the one-line reason."""
-
-
-def stack_params(
-    scenario: Scenario, scenario_path: Path, planner: str
-) -> dict[str, dict[str, Any]]:
-    """Per-service parameters that follow from the scenario (robot, laser, world grid)."""
-    robot, laser, cell = scenario.robot, scenario.laser, scenario.world.cell
-    scan_period = 1.0 / laser.rate_hz
-    return {
-        "simulator": {"scenario": str(scenario_path.resolve()), "clock": "lockstep",
-                      "wait_for": ["laser_driver", "perception", "tracking", "planner",
-                                   "motor_bridge", "run"]},
-        "laser_driver": {"fov_deg": laser.fov_deg, "resolution_deg": laser.resolution_deg,
-                         "range_max": laser.max_range, "rate_hz": laser.rate_hz},
-        "perception": {"cell": cell, "window_radius": min(8 * cell, laser.max_range)},
-        "tracking": {"fov_deg": laser.fov_deg, "view_range": min(8 * cell, laser.max_range)},
-        "planner": {"goal": list(robot.goal), "start": list(robot.start),
-                    "goal_tolerance": robot.goal_tolerance, "cruise_speed": robot.speed,
-                    "max_speed": robot.effective_max_speed, "robot_radius": robot.radius,
-                    "cell": cell, "window_radius": min(8 * cell, laser.max_range)},
-        "motor_bridge": {"max_speed": robot.effective_max_speed, "robot_radius": robot.radius,
-                         "command_period": scan_period,
-                         "stale_timeout": max(0.5, 3 * scan_period)},
-    }
 
 
 def apply_override(params: dict[str, dict[str, Any]], text: str) -> None:
@@ -185,8 +166,8 @@ def run_scenario(
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
-    if planner not in PLANNER_MODULES:
-        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNER_MODULES)}")
+    if planner not in PLANNERS:
+        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
     params = stack_params(scenario, scenario_path, planner)
     for text in overrides or []:
         apply_override(params, text)

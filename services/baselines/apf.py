@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from pydantic import Field
 
 from zenav.services.baselines.common import (
     Cycle,
@@ -35,22 +34,8 @@ from zenav.services.baselines.common import (
     returns,
     world_points,
 )
+from zenav.services.baselines.params import APFParams as Params
 from zenav.services.geometry import wrap_angle
-from zenav.services.planner.params import MissionParams
-
-
-class Params(MissionParams):
-    k_att: float = Field(1.0, gt=0, description="attractive gain, 1/s (pull per m to the goal)")
-    d_star: float = Field(1.0, gt=0, description="beyond this distance to the goal the pull "
-                          "is constant, m")
-    k_rep: float = Field(0.02, gt=0, description="eta: repulsive gain, m³/s")
-    d0: float = Field(1.0, gt=0, description="rho_0: influence distance of an obstacle, m")
-    min_gap: float = Field(0.01, gt=0, description="gaps below this count as this, m "
-                           "(keeps the push finite)")
-    segment_gap: float = Field(0.3, gt=0, description="neighbouring returns farther apart "
-                               "than this belong to different obstacles, m")
-    heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of angle to the "
-                                "force, 1/s")
 
 
 @dataclass(frozen=True)

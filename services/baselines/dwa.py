@@ -38,7 +38,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from pydantic import Field
 from scipy.spatial import cKDTree
 
 from zenav.services.baselines.common import (
@@ -48,40 +47,8 @@ from zenav.services.baselines.common import (
     returns,
     world_points,
 )
+from zenav.services.baselines.params import DWAParams as Params
 from zenav.services.geometry import wrap_angles
-from zenav.services.planner.params import MissionParams
-
-
-class Params(MissionParams):
-    max_vel_x: float | None = Field(None, gt=0, description="top forward speed, m/s "
-                                    "(default: the cruise speed)")
-    min_vel_x: float = Field(0.0, ge=0, description="lowest forward speed, m/s (no reverse)")
-    max_vel_theta: float = Field(1.0, gt=0, description="turn rate limit, rad/s (ROS: 1.0)")
-    acc_lim_x: float = Field(0.5, gt=0, description="v̇: forward acceleration, m/s² "
-                             "(the motor bridge's)")
-    decel_lim_x: float = Field(1.0, gt=0, description="v̇_b: braking deceleration for "
-                               "admissibility, m/s² (the motor bridge's)")
-    acc_lim_theta: float = Field(3.2, gt=0, description="ω̇: turn acceleration, rad/s² "
-                                 "(ROS: 3.2)")
-    control_period: float = Field(0.1, gt=0, description="Δt: one scan period, s")
-    sim_time: float = Field(2.0, gt=0, description="forward simulation horizon, s")
-    sim_granularity: float = Field(0.1, gt=0, description="forward simulation step, s")
-    arc_step: float = Field(0.1, gt=0, description="step along each curvature when "
-                            "looking for the first contact, m")
-    vx_samples: int = Field(7, ge=1, description="forward speed samples in the window")
-    vth_samples: int = Field(21, ge=1, description="turn rate samples in the window")
-    alpha: float = Field(2.0, ge=0, description="weight of heading")
-    beta: float = Field(0.2, ge=0, description="weight of dist (clearance on the arc)")
-    gamma: float = Field(0.2, ge=0, description="weight of velocity")
-    dist_cap: float = Field(2.0, gt=0, description="dist of an arc with nothing on it, m")
-    safety_margin: float = Field(0.05, ge=0, description="gap kept between footprints on "
-                                 "top of the radii, m")
-    mover_clearance: float = Field(0.15, ge=0, description="scan returns this close to a "
-                                   "mover's surface are the mover's, m")
-
-    @property
-    def v_max(self) -> float:
-        return self.max_vel_x if self.max_vel_x is not None else self.cruise_speed
 
 
 @dataclass(frozen=True)
@@ -110,10 +77,10 @@ def plan(cycle: Cycle, p: Params) -> Decision:
     x, y, heading = cycle.pose
     v0, w0 = cycle.velocity
     dt = p.control_period
-    v_hi = min(p.v_max, v0 + p.acc_lim_x * dt)
-    v_lo = min(max(p.min_vel_x, v0 - p.acc_lim_x * dt), v_hi)
-    w_hi = min(p.max_vel_theta, w0 + p.acc_lim_theta * dt)
-    w_lo = min(max(-p.max_vel_theta, w0 - p.acc_lim_theta * dt), w_hi)
+    v_hi = min(p.v_max, v0 + p.accel * dt)
+    v_lo = min(max(p.min_vel_x, v0 - p.accel * dt), v_hi)
+    w_hi = min(p.max_omega, w0 + p.acc_lim_theta * dt)
+    w_lo = min(max(-p.max_omega, w0 - p.acc_lim_theta * dt), w_hi)
     vs = np.linspace(v_lo, v_hi, p.vx_samples)
     ws = np.linspace(w_lo, w_hi, p.vth_samples)
     if w_lo < 0.0 < w_hi:
@@ -164,7 +131,7 @@ def plan(cycle: Cycle, p: Params) -> Decision:
         first = hit.argmax(axis=1)
         meet = v * times[first] - v * p.sim_granularity  # the last pose before contact
         dist = np.where(hit.any(axis=1), np.minimum(dist, np.maximum(meet, 0.0)), dist)
-    admissible = v <= np.sqrt(2.0 * dist * p.decel_lim_x) + 1e-9
+    admissible = v <= np.sqrt(2.0 * dist * p.decel) + 1e-9
 
     gx, gy = cycle.goal
     end_x, end_y, end_theta = px[:, 0], py[:, 0], theta[:, 0]  # after one period

@@ -1,5 +1,6 @@
-"""The planner node every baseline shares: the same inputs and outputs as the paper's
-planner, so a baseline runs as the ``planner`` service (``--planner vfh|dwa|apf``).
+"""The baseline planners as the ``planner`` service (``zenav run --planner vfh|dwa|apf``,
+``zenav service planner --planner vfh|dwa|apf``): the same inputs and outputs as the
+paper's planner. Algorithms: ``vfh.py``, ``dwa.py``, ``apf.py``; parameters: ``params.py``.
 
 It answers each track list with one velocity command stamped with the tracks' stamp
 (lockstep depends on it) and answers a repeated stamp by repeating its command. The
@@ -27,7 +28,11 @@ from zenav.schemas.messages import (
     TrackList,
     VelocityCommand,
 )
+from zenav.services.baselines.apf import APF
 from zenav.services.baselines.common import Cycle, Obstacles, goal_reached
+from zenav.services.baselines.dwa import DWA
+from zenav.services.baselines.params import APFParams, DWAParams, VFHParams
+from zenav.services.baselines.vfh import VFH
 from zenav.services.node import Node, StampGate
 from zenav.services.planner.params import MissionParams
 
@@ -140,3 +145,18 @@ class BaselineService:
         self.state.publish(PlannerState(
             stamp=tracks.stamp, seq=self.state.next_seq(), scenario="a", action=action,
             target=self.params.goal, speed=max(v, 0.0)))
+
+
+class VFHService(BaselineService):
+    def __init__(self, node: Node, params: VFHParams) -> None:
+        super().__init__(node, params, VFH(params))
+
+
+class DWAService(BaselineService):
+    def __init__(self, node: Node, params: DWAParams) -> None:
+        super().__init__(node, params, DWA(params))
+
+
+class APFService(BaselineService):
+    def __init__(self, node: Node, params: APFParams) -> None:
+        super().__init__(node, params, APF(params))

@@ -40,62 +40,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from pydantic import Field, model_validator
 
 from zenav.services.baselines.common import Cycle, FloatArray, returns
+from zenav.services.baselines.params import VFHParams as Params
 from zenav.services.geometry import wrap_angle, wrap_positive
-from zenav.services.planner.params import MissionParams
 
 IntArray = npt.NDArray[np.int64]
-
-
-class Params(MissionParams):
-    grid_cell: float = Field(0.1, gt=0, description="histogram grid cell size, m "
-                             "(paper: 10 cm)")
-    grid_extent: float = Field(60.0, gt=0, description="side of the square histogram grid, "
-                               "centred on the first pose, m")
-    window_cells: int = Field(33, ge=3, description="w_s: active window side, cells (odd)")
-    sector_deg: float = Field(5.0, gt=0, le=45, description="alpha: polar sector width, deg")
-    b: float = Field(1.0, gt=0, description="b: magnitude fall-off with distance, 1/m "
-                     "(a = b d_max, so a - b d_max = 0)")
-    certainty_max: int = Field(15, ge=1, description="HIMM: largest certainty value")
-    increment: int = Field(3, ge=1, description="HIMM: certainty added per return in a cell")
-    decrement: int = Field(1, ge=0, description="HIMM: certainty removed per beam through "
-                           "a cell")
-    smoothing: int = Field(5, ge=1, description="l: half-width of the smoothing window, "
-                           "sectors")
-    threshold: float = Field(250.0, gt=0, description="smoothed density below which a sector "
-                             "is free (empirical)")
-    s_max: int = Field(18, ge=1, description="valley width above which a valley is wide, "
-                       "sectors (paper: 18)")
-    h_m: float = Field(600.0, gt=0, description="density straight ahead at which the speed "
-                       "drops to V_min (empirical)")
-    v_min: float = Field(0.0, ge=0, description="V_min: speed added after the reductions, m/s")
-    heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of steering "
-                                "error, 1/s")
-    keep_valley_deg: float = Field(
-        15.0, ge=0, description="beyond the 1991 paper (as VFH+ does): the valley steered "
-        "through last is kept unless another is this much nearer the target, deg; without "
-        "it the robot dithers between two valleys either side of an obstacle on its way")
-
-    @model_validator(mode="after")
-    def _odd_window(self) -> Params:
-        if self.window_cells % 2 == 0:
-            raise ValueError("window_cells must be odd (the robot's cell is the centre)")
-        return self
-
-    @property
-    def sectors(self) -> int:
-        return max(1, round(360.0 / self.sector_deg))
-
-    @property
-    def d_max(self) -> float:
-        """Distance from the robot's cell to a corner of the active window, m."""
-        return math.sqrt(2.0) * (self.window_cells - 1) / 2 * self.grid_cell
-
-    @property
-    def a(self) -> float:
-        return self.b * self.d_max
 
 
 class HistogramGrid:

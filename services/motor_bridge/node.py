@@ -12,107 +12,19 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
-from typing import Literal
-
-from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCommand
-from zenav.services.geometry import limit_velocity
-from zenav.services.motor_bridge.stop_zone import stop_distance, zone_blocked
+from zenav.services.motor_bridge.command_filter import CommandFilter, Limiter
+from zenav.services.motor_bridge.params import Params
 from zenav.services.node import Node, StampGate
+
+__all__ = ["CommandFilter", "Limiter", "Params", "Service"]
+# Params and CommandFilter are also read from here by zenav/inprocess.py.
 
 log = logging.getLogger(__name__)
 
 SCANS_KEPT = 8
-
-
-class Params(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    max_speed: float = Field(0.2, gt=0, description="forward speed limit, m/s")
-    allow_reverse: bool = Field(False, description="whether negative speeds pass")
-    max_omega: float = Field(1.5, gt=0, description="turn rate limit, rad/s")
-    accel: float = Field(0.5, gt=0, description="forward acceleration limit, m/s^2")
-    decel: float = Field(1.0, gt=0, description="forward deceleration limit, m/s^2")
-    angular_accel: float = Field(4.0, gt=0, description="turn rate change limit, rad/s^2")
-    stale_timeout: float = Field(
-        0.5, gt=0, description="s without a command before the robot is stopped"
-    )
-    command_period: float = Field(
-        0.1, gt=0, description="nominal s between commands, used for the first one"
-    )
-    clock: Literal["sim", "realtime"] = Field(
-        "sim", description="'realtime' adds a wall-clock watchdog to the stamp-clock check"
-    )
-    watchdog_period: float = Field(0.05, gt=0, description="wall s between watchdog checks")
-    stop_zone: bool = Field(True, description="refuse forward motion toward a return in the "
-                            "zone ahead (reads the raw scan)")
-    robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
-    zone_side_margin: float = Field(0.02, ge=0, description="zone half-width beyond the "
-                                    "robot radius, m")
-    zone_margin: float = Field(0.08, ge=0, description="zone length beyond the robot's "
-                               "front at standstill, m")
-    zone_reaction: float = Field(0.3, ge=0, description="s of travel added to the zone: one "
-                                 "command period and some")
-
-
-class Limiter:
-    """Speed and acceleration limits between successive commands (pure, no I/O)."""
-
-    def __init__(self, params: Params) -> None:
-        self.params = params
-        self.v = 0.0
-        self.omega = 0.0
-        self.stamp: float | None = None
-
-    def apply(self, stamp: float, v: float, omega: float) -> tuple[float, float]:
-        p = self.params
-        dt = p.command_period if self.stamp is None else max(stamp - self.stamp, 0.0)
-        v_low = -p.max_speed if p.allow_reverse else 0.0
-        v_target = min(max(v, v_low), p.max_speed)
-        self.v = limit_velocity(self.v, v_target, p.accel, p.decel, dt, p.max_speed)
-        self.omega = limit_velocity(
-            self.omega, omega, p.angular_accel, p.angular_accel, dt, p.max_omega
-        )
-        self.stamp = stamp
-        return self.v, self.omega
-
-    def stop(self, stamp: float) -> None:
-        self.v = 0.0
-        self.omega = 0.0
-        self.stamp = stamp
-
-
-Reason = Literal["command", "stop_zone"]
-
-
-class CommandFilter:
-    """Limits plus the stop zone: what reaches the base for one command (pure, no I/O)."""
-
-    def __init__(self, params: Params) -> None:
-        self.params = params
-        self.limiter = Limiter(params)
-
-    def blocked(self, scan: LaserScan | None, v: float) -> bool:
-        p = self.params
-        if not p.stop_zone or scan is None:
-            return False
-        ahead = stop_distance(v, p.zone_reaction, p.decel, p.zone_margin)
-        return zone_blocked(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_max,
-                            v, p.robot_radius, p.zone_side_margin, ahead)
-
-    def apply(
-        self, stamp: float, v: float, omega: float, scan: LaserScan | None
-    ) -> tuple[float, float, Reason]:
-        reason: Reason = "command"
-        if self.blocked(scan, max(v, self.limiter.v)):
-            v, reason = min(v, 0.0), "stop_zone"
-        v, omega = self.limiter.apply(stamp, v, omega)
-        if reason == "stop_zone":
-            v = min(v, 0.0)  # at once: the base's own deceleration limit applies
-            self.limiter.v = v
-        return v, omega, reason
 
 
 class Service:

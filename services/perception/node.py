@@ -21,8 +21,6 @@ from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
 from zenav.services.perception.wire import to_message
 
-Params = PerceptionParams
-
 POSE_HISTORY = 200
 """Odometry messages kept for matching scans to poses (20 s at 10 Hz)."""
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from zenav.services.mission import CELL, WINDOW_RADIUS
+
 
 class PerceptionParams(BaseModel):
     """Sliding window, grid and clustering parameters."""
@@ -16,13 +18,13 @@ class PerceptionParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     window_radius: float = Field(
-        4.0,
+        WINDOW_RADIUS,
         gt=0.0,
         description="r_w, metres: radius of the sliding window around the robot; beams with "
         "rho > r_w are ignored. Paper: 8 cells x 0.5 m = 4.0 m.",
     )
     cell: float = Field(
-        0.5,
+        CELL,
         gt=0.0,
         description="r, metres: grid resolution of Eq. 2 (paper: 500 mm).",
     )

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from zenav.services.mission import CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
+
 
 class MissionParams(BaseModel):
     """What every planner implementation is given (``zenav run`` fills it from the
@@ -20,13 +22,14 @@ class MissionParams(BaseModel):
 
     # --- the robot ------------------------------------------------------------------
     cruise_speed: float = Field(0.1, gt=0, description="V_R, m/s")
-    max_speed: float = Field(0.2, gt=0, description="top speed when speeding up, m/s")
-    robot_radius: float = Field(0.2, gt=0, description="disc footprint, m")
-    max_omega: float = Field(1.0, gt=0, description="turn rate limit, rad/s")
+    max_speed: float = Field(MAX_SPEED, gt=0, description="top speed when speeding up, m/s")
+    robot_radius: float = Field(ROBOT_RADIUS, gt=0, description="disc footprint, m")
+    max_omega: float = Field(MAX_OMEGA, gt=0, description="turn rate limit, rad/s")
 
     # --- the world model ------------------------------------------------------------
-    cell: float = Field(0.5, gt=0, description="grid resolution r, m (Eq. 2)")
-    window_radius: float = Field(4.0, gt=0, description="r_w: obstacles beyond are ignored, m")
+    cell: float = Field(CELL, gt=0, description="grid resolution r, m (Eq. 2)")
+    window_radius: float = Field(WINDOW_RADIUS, gt=0,
+                                 description="r_w: obstacles beyond are ignored, m")
     moving_speed: float = Field(
         0.03, ge=0, description="tracks slower than this are treated as standing still, m/s"
     )

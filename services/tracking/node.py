@@ -12,8 +12,6 @@ from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Track as TrackState
 from zenav.services.tracking.tracker import Tracker
 
-Params = TrackingParams
-
 
 def track_message(track: TrackState) -> Track:
     return Track(

@@ -13,6 +13,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from zenav.services.mission import WINDOW_RADIUS
+
 
 class TrackingParams(BaseModel):
     """Thresholds, association, drop time and velocity-filter settings."""
@@ -63,12 +65,13 @@ class TrackingParams(BaseModel):
     fov_deg: float = Field(
         180.0, gt=0.0, le=360.0,
         description="degrees, centred on the heading: the scanner's field of view. A static "
-        "track outside it (or beyond view_range) cannot be seen, so it is remembered for "
+        "track outside it (or beyond window_radius) cannot be seen, so it is remembered for "
         "'memory' seconds instead of dropped after drop_after: the obstacle beside or behind "
         "the robot is still there while it drives past.",
     )
-    view_range: float = Field(
-        4.0, gt=0.0, description="metres: how far obstacles are seen (the sliding window r_w)."
+    window_radius: float = Field(
+        WINDOW_RADIUS, gt=0.0, description="metres: how far obstacles are seen (the sliding "
+        "window r_w)."
     )
     memory: float = Field(
         30.0, ge=0.0, description="seconds: how long a static track out of view is kept."

@@ -317,7 +317,7 @@ class Tracker:
         occlusion): inside the field of view and the view range."""
         dx, dy = t.x - pose[0], t.y - pose[1]
         distance = math.hypot(dx, dy)
-        if distance - t.radius > self.params.view_range:
+        if distance - t.radius > self.params.window_radius:
             return False
         bearing = math.atan2(dy, dx) - pose[2]
         bearing = math.atan2(math.sin(bearing), math.cos(bearing))

@@ -25,7 +25,7 @@ from zenav.schemas.messages import (
     VelocityCommand,
 )
 from zenav.services.node import Node
-from zenav.services.runner import PLANNER_MODULES, service_module
+from zenav.services.runner import PLANNERS, implementation
 from zenav.services.transport import InMemoryBus
 
 POSE = Pose2D(x=2.0, y=5.0, heading=0.0)
@@ -36,7 +36,7 @@ async def planner(name: str, **params: object) -> AsyncIterator[Harness]:
     bus = InMemoryBus()
     k = Keys("test")
     node = Node("planner", bus, k)
-    module = service_module("planner", name)
+    module = implementation("planner", name)
     service = module.Service(node, module.Params(goal=(8.0, 5.0), **params))
     task = asyncio.create_task(node.spin())
     await asyncio.sleep(0)
@@ -58,7 +58,7 @@ def tracks(t: float, pose: Pose2D = POSE) -> TrackList:
 
 
 def test_the_baselines_are_planner_implementations():
-    assert {"vfh", "dwa", "apf"} <= set(PLANNER_MODULES)
+    assert {"vfh", "dwa", "apf"} <= set(PLANNERS)
 
 
 @pytest.mark.parametrize("name", ["vfh", "dwa", "apf"])

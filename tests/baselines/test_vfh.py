@@ -7,13 +7,14 @@ import math
 import numpy as np
 
 from tests.baselines.scans import cycle, drive, world
-from zenav.services.baselines.vfh import VFH, Params, smooth, steer, valleys
+from zenav.services.baselines.params import VFHParams
+from zenav.services.baselines.vfh import VFH, smooth, steer, valleys
 
 SECTOR = math.radians(5.0)
 
 
 def test_free_space_heads_straight_for_the_goal_at_cruise_speed():
-    planner = VFH(Params(goal=(8.0, 5.0), cruise_speed=0.3))
+    planner = VFH(VFHParams(goal=(8.0, 5.0), cruise_speed=0.3))
     d = planner.step(cycle(world(), (2.0, 5.0, 0.0), (8.0, 5.0)))
     assert d.direction is not None and abs(math.remainder(d.direction, 2 * math.pi)) < 1e-9
     assert d.v == 0.3 and d.omega == 0.0
@@ -22,7 +23,7 @@ def test_free_space_heads_straight_for_the_goal_at_cruise_speed():
 def test_picks_the_free_valley_beside_a_wall_ahead():
     # A wall across the way ahead and to the left; the way round is on the right.
     w = world({"shape": "box", "center": [3.5, 5.6], "size": [0.4, 2.4]})
-    planner = VFH(Params(goal=(8.0, 5.0)))
+    planner = VFH(VFHParams(goal=(8.0, 5.0)))
     for _ in range(5):  # HIMM builds certainty over a few scans
         d = planner.step(cycle(w, (2.0, 5.0, 0.0), (8.0, 5.0)))
     assert d.direction is not None
@@ -33,7 +34,7 @@ def test_picks_the_free_valley_beside_a_wall_ahead():
 
 def test_speed_falls_with_the_density_straight_ahead():
     w = world({"shape": "disc", "center": [3.0, 5.0], "radius": 0.3})
-    planner = VFH(Params(goal=(8.0, 5.0), cruise_speed=0.3))
+    planner = VFH(VFHParams(goal=(8.0, 5.0), cruise_speed=0.3))
     for _ in range(5):
         d = planner.step(cycle(w, (2.0, 5.0, 0.0), (8.0, 5.0)))
     assert d.density_ahead > 0
@@ -43,7 +44,7 @@ def test_speed_falls_with_the_density_straight_ahead():
 def test_drives_round_a_box_on_the_way_without_touching_it():
     box = {"shape": "box", "center": [4.0, 5.0], "size": [0.5, 0.5]}
     w = world(box)
-    planner = VFH(Params(goal=(7.0, 5.0), cruise_speed=0.2))
+    planner = VFH(VFHParams(goal=(7.0, 5.0), cruise_speed=0.2))
     pose = (2.0, 5.0, 0.0)
     closest = math.inf
     for _ in range(400):

@@ -24,11 +24,11 @@ from pathlib import Path
 
 from tests.integration.fuzz_inject import FUZZED, SUBSCRIBERS, Generator, must_be_refused
 from zenav.launch import Stack
-from zenav.run import stack_params
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import RunResult, ServiceStatus
+from zenav.services.mission import stack_params
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import load_scenario
 

@@ -11,7 +11,7 @@ from zenav.schemas.codec import decode, encode
 from zenav.schemas.keys import Keys, Topic
 from zenav.schemas.messages import Message
 from zenav.services.node import Node
-from zenav.services.runner import service_module
+from zenav.services.runner import implementation
 from zenav.services.transport import InMemoryBus
 
 M = TypeVar("M", bound=Message)
@@ -45,7 +45,7 @@ async def running(name: str, params: Any) -> AsyncIterator[Harness]:
     bus = InMemoryBus()
     keys = Keys("test")
     node = Node(name, bus, keys)
-    service = service_module(name).Service(node, params)
+    service = implementation(name).Service(node, params)
     task = asyncio.create_task(node.spin())
     run = getattr(service, "run", None)
     run_task = asyncio.create_task(run()) if run is not None else None

@@ -29,8 +29,8 @@ from zenav.schemas.messages import (
     RawLaserFrame,
     VelocityCommand,
 )
-from zenav.services.laser_driver.node import Params as LaserParams
-from zenav.services.motor_bridge.node import Params as BridgeParams
+from zenav.services.laser_driver.params import Params as LaserParams
+from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.node import MAX_FUTURE, RESYNC_COUNT
 
 

@@ -9,7 +9,7 @@ import pytest
 from tests.service.harness import running
 from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, Odometry, Pose2D, VelocityCommand
-from zenav.services.motor_bridge.node import Params
+from zenav.services.motor_bridge.params import Params
 
 
 def odom(t: float) -> Odometry:

@@ -14,7 +14,7 @@ from zenav.graph import derive_graph, probe_service, schema_digest
 from zenav.schemas import keys
 from zenav.schemas.keys import Topic
 from zenav.schemas.messages import ALL_MESSAGES
-from zenav.services.runner import PLANNER_MODULES
+from zenav.services.runner import PLANNERS
 
 GRAPH = Path(__file__).resolve().parents[2] / "deploy" / "graph.yaml"
 MESSAGES = {m.__name__: m for m in ALL_MESSAGES}
@@ -64,7 +64,7 @@ def test_the_graph_agrees_with_the_key_registry_and_the_schemas(documented):
         assert info["schema"] == schema_digest(MESSAGES[name])
 
 
-@pytest.mark.parametrize("planner", sorted(PLANNER_MODULES))
+@pytest.mark.parametrize("planner", sorted(PLANNERS))
 def test_every_planner_implementation_can_replace_the_planner(documented, planner):
     """Whatever it reads is in the graph with that type; what it writes is the planner's."""
     entry, _ = probe_service("planner", planner)
