@@ -1,5 +1,8 @@
 """Parameters: code defaults, overridden by YAML files, overridden by ``--set``.
 
+Each value's origin is kept (:func:`resolve`): ``default`` (the code), ``scenario`` (what
+:func:`zenav.services.mission.stack_params` derives), ``file`` or ``--set``.
+
 Every service keeps all its parameters, with defaults and units, in one pydantic model.
 ``deploy/params/<service>.yaml`` and any ``--config FILE`` override them; an error names
 the file, the field and the problem.
@@ -7,11 +10,14 @@ the file, the field and the problem.
 
 from __future__ import annotations
 
+import textwrap
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Literal, TypeVar
 
 import yaml
 from pydantic import BaseModel, ValidationError
+from pydantic_core import ErrorDetails
 
 from zenav.services.transport import TransportConfig
 
@@ -73,34 +79,95 @@ def _merge(base: dict[str, Any], update: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
-def format_validation_error(source: str, exc: ValidationError) -> str:
-    lines = []
-    for error in exc.errors(include_url=False):
-        where = ".".join(str(p) for p in error["loc"]) or "(top level)"
-        got = f" (got {error['input']!r})" if error["type"] != "missing" else ""
-        lines.append(f"{source}: {where}: {error['msg']}{got}")
+def format_error(source: str, error: ErrorDetails) -> str:
+    where = ".".join(str(p) for p in error["loc"]) or "(top level)"
+    got = f" (got {error['input']!r})" if error["type"] != "missing" else ""
+    return f"{source}: {where}: {error['msg']}{got}"
+
+
+Origin = Literal["default", "scenario", "file", "--set"]
+"""Where a parameter's value came from, lowest precedence first."""
+
+
+@dataclass(frozen=True)
+class Layer:
+    """Parameter values from one source, applied over the ones before it."""
+
+    origin: Origin
+    source: str  # as error messages name it: the file, "--set NAME=VALUE", "scenario FILE"
+    values: dict[str, Any]
+
+
+def file_layer(path: Path) -> Layer:
+    return Layer("file", str(path), read_yaml(path))
+
+
+def assignment_layer(text: str) -> Layer:
+    path_parts, value = parse_assignment(text)
+    nested: dict[str, Any] = {path_parts[-1]: value}
+    for part in reversed(path_parts[:-1]):
+        nested = {part: nested}
+    return Layer("--set", f"--set {text}", nested)
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One parameter as used: its value (as YAML would show it) and where it came from."""
+
+    name: str
+    value: Any
+    origin: Origin
+    source: str
+    description: str | None
+
+
+def resolve(model: type[P], layers: list[Layer]) -> tuple[P, list[Setting]]:
+    """Build ``model`` from its defaults and then each layer in order; each parameter with
+    the layer that set it last. Raises ConfigError naming the layer of each problem."""
+    data: dict[str, Any] = {}
+    set_by: dict[str, Layer] = {}
+    for layer in layers:
+        data = _merge(data, layer.values)
+        set_by.update(dict.fromkeys(layer.values, layer))
+    try:
+        params = model.model_validate(data)
+    except ValidationError as exc:
+        everyone = " + ".join(layer.source for layer in layers) or "defaults"
+        lines = []
+        for error in exc.errors(include_url=False):
+            first = str(error["loc"][0]) if error["loc"] else ""
+            source = set_by[first].source if first in set_by else everyone
+            lines.append(format_error(source, error))
+        raise ConfigError("\n".join(lines)) from None
+    shown = params.model_dump(mode="json")
+    settings = [
+        Setting(name, shown[name], set_by[name].origin if name in set_by else "default",
+                set_by[name].source if name in set_by else "code", info.description)
+        for name, info in model.model_fields.items()
+    ]
+    return params, settings
+
+
+def show_settings(title: str, settings: list[Setting], width: int = 88) -> str:
+    """The settings as YAML a service reads back: each description as comments, each
+    value with its origin (and the file or scenario it came from) after it."""
+    lines = [f"# {title}"]
+    for setting in settings:
+        if setting.description:
+            lines += [f"# {line}" for line in textwrap.wrap(setting.description, width)]
+        value = yaml.safe_dump(setting.value, default_flow_style=True).strip()
+        value = value.removesuffix("...").strip()
+        where = setting.origin if setting.origin in ("default", "--set") else (
+            f"{setting.origin} {setting.source.removeprefix('scenario ')}")
+        lines.append(f"{setting.name}: {value}  # {where}")
     return "\n".join(lines)
 
 
 def load_params(model: type[P], files: list[Path], assignments: list[str]) -> P:
     """Build ``model`` from its defaults, then each file in order, then the assignments."""
-    data: dict[str, Any] = {}
-    sources = []
-    for path in files:
-        data = _merge(data, read_yaml(path))
-        sources.append(str(path))
-    for text in assignments:
-        path_parts, value = parse_assignment(text)
-        nested: dict[str, Any] = {path_parts[-1]: value}
-        for part in reversed(path_parts[:-1]):
-            nested = {part: nested}
-        data = _merge(data, nested)
-        sources.append(f"--set {text}")
-    try:
-        return model.model_validate(data)
-    except ValidationError as exc:
-        source = " + ".join(sources) or "defaults"
-        raise ConfigError(format_validation_error(source, exc)) from None
+    layers = [file_layer(path) for path in files]
+    layers += [assignment_layer(text) for text in assignments]
+    return resolve(model, layers)[0]
 
 
 def loopback_port(service: str, base_port: int = DEFAULT_BASE_PORT) -> int:

@@ -16,6 +16,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Protocol
 
+from zenav.services.config import Layer
+
 # --- the robot (the paper's Pioneer-sized robot) -------------------------------------
 ROBOT_RADIUS = 0.2
 """Disc footprint, m."""
@@ -120,3 +122,10 @@ def stack_params(
                          "stale_timeout": max(0.5, 3 * scan_period)},
     }
 
+
+def scenario_layer(
+    scenario: ScenarioLike, scenario_path: Path, service: str, planner: str = "paper"
+) -> Layer:
+    """What the scenario sets of one service's parameters, as a layer over the defaults."""
+    values = stack_params(scenario, scenario_path, planner).get(service, {})
+    return Layer("scenario", f"scenario {scenario_path}", values)

@@ -5,10 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import textwrap
 from pathlib import Path
-
-import yaml
 
 from zenav.services.config import SERVICE_ORDER
 
@@ -54,28 +51,6 @@ def _cmd_schemas(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_params(args: argparse.Namespace) -> int:
-    """Print every parameter of a service with its default and description, as YAML."""
-    from zenav.services.runner import service_module
-
-    model = service_module(args.name).Params
-    print(f"# {args.name}: every parameter with its default (zenav params {args.name})")
-    for field_name, info in model.model_fields.items():
-        if info.description:
-            for line in textwrap.wrap(info.description, 88):
-                print(f"# {line}")
-        default = info.get_default(call_default_factory=True)
-        if hasattr(default, "model_dump"):
-            default = default.model_dump(mode="json")
-        elif isinstance(default, tuple):
-            default = list(default)
-        elif default is not None and not isinstance(default, (int, float, str, bool, list)):
-            default = str(default)
-        value = yaml.safe_dump(default, default_flow_style=True).strip()
-        print(f"{field_name}: {value.removesuffix('...').strip()}")
-    return 0
-
-
 def _cmd_paper(args: argparse.Namespace) -> int:
     from zenav.paper import main as paper_main
     from zenav.run import RunError
@@ -108,8 +83,9 @@ def build_parser() -> argparse.ArgumentParser:
                                          "(zenav service NAME --help).")
     service.add_argument("name", choices=SERVICE_ORDER)
 
-    params = sub.add_parser("params", help="print a service's parameters and defaults")
-    params.add_argument("name", choices=SERVICE_ORDER)
+    from zenav.paramscmd import add_command as add_params_command
+
+    add_params_command(sub)
 
     schemas = sub.add_parser("schemas", help="write the JSON Schema of every message")
     schemas.add_argument("--out", type=Path, default=Path("schemas/json"))
@@ -144,6 +120,4 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.func(args))
     if args.command == "run":
         return _cmd_run(args)
-    if args.command == "params":
-        return _cmd_params(args)
     return _cmd_schemas(args)
