@@ -21,7 +21,7 @@ from typing import IO, Any
 import pytest
 import yaml
 
-from zenav.deploy import Supervisor
+from zenav.deploy.rpc import Supervisor
 
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"

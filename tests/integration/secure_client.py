@@ -22,11 +22,11 @@ from typing import Any
 
 import zenoh
 
+from zenav.deploy.secure import tls_settings
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode, encode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, ServiceStatus, VelocityCommand
-from zenav.secure import tls_settings
 from zenav.services.transport import TransportConfig
 
 

@@ -9,11 +9,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from zenav.deploy import (
-    load_deployment,
-    prepare,
-    socket_path,
-)
+from zenav.deploy.conf import prepare, socket_path
+from zenav.deploy.model import load_deployment
 from zenav.services.config import SERVICE_ORDER, ConfigError
 from zenav.tooling import CLIENT_EXTRA
 
@@ -152,7 +149,7 @@ def test_a_missing_scenario_is_refused_when_the_file_is_read(tmp_path):
 
 
 def test_zenav_down_reads_from_supervisords_log_which_stops_were_clean(tmp_path):
-    from zenav.deploy import unclean_stops
+    from zenav.deploy.rpc import unclean_stops
 
     log = tmp_path / "supervisord.log"
     log.write_text("... INFO stopped: old (terminated by SIGKILL)\n")

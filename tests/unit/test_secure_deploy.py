@@ -8,8 +8,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from zenav.deploy import load_deployment, prepare
-from zenav.secure import PARTIES, access_control
+from zenav.deploy.conf import prepare
+from zenav.deploy.model import load_deployment
+from zenav.deploy.secure import PARTIES, access_control
 from zenav.services.config import ConfigError
 
 REPO = Path(__file__).resolve().parents[2]

@@ -20,7 +20,7 @@ import zenoh
 
 from zenav.schemas.keys import Keys, check_robot_id
 from zenav.services.config import ConfigError
-from zenav.services.runner import setup_logging, transport_from_args
+from zenav.services.runner import add_transport_arguments, setup_logging, transport_from_args
 from zenav.services.transport import TransportConfig
 
 log = logging.getLogger(__name__)
@@ -68,3 +68,11 @@ def main(args: argparse.Namespace) -> int:
         session.close()
     log.info("router stopped")
     return 0
+
+
+def add_command(sub: Any) -> None:
+    router = sub.add_parser("router", help="run a Zenoh router (the robot's, for off-board "
+                            "services and monitors)")
+    router.add_argument("--log-level", default="INFO")
+    add_transport_arguments(router)
+    router.set_defaults(func=main)
