@@ -14,14 +14,17 @@ import contextlib
 import logging
 import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypeVar
 
 from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
 log = logging.getLogger(__name__)
+
+T = TypeVar("T")
 
 CLIENT_EXTRA: dict[str, Any] = {
     # Wait for the router instead of failing to open when it is not up yet (a service
@@ -74,6 +77,15 @@ def stop_on_signals(stop: asyncio.Event) -> None:
             loop.add_signal_handler(signum, stop.set)
 
 
+async def wait_for_event(event: asyncio.Event, timeout: float | None) -> bool:
+    """Whether ``event`` was set within ``timeout`` s (None: however long it takes)."""
+    try:
+        await asyncio.wait_for(event.wait(), timeout=timeout)
+    except TimeoutError:
+        return False
+    return True
+
+
 SampleCallback = Callable[[str, bytes, int], None]
 """Called on the asyncio loop with (key, payload, wall-clock receive time in ns)."""
 
@@ -103,3 +115,39 @@ class StampedSubscriber:
             with contextlib.suppress(Exception):
                 self._handle.undeclare()
             self._handle = None
+
+
+class ThreadedBus:
+    """A :class:`ZenohBus` whose asyncio loop runs in a thread of its own, for a tool that
+    is not asynchronous (a benchmark that listens while its main thread waits and
+    measures). Declare subscribers with :meth:`call`: they belong on the bus's loop."""
+
+    def __init__(self, transport: TransportConfig) -> None:
+        self.loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self.loop.run_forever, name="zenav-bus",
+                                        daemon=True)
+        self._thread.start()
+        try:
+            self.bus: ZenohBus = self.call(lambda: ZenohBus(transport, self.loop))
+        except BaseException:
+            self._stop()
+            raise
+
+    def call(self, function: Callable[[], T]) -> T:
+        """``function()`` run on the bus's loop; its result."""
+
+        async def run() -> T:
+            return function()
+
+        return asyncio.run_coroutine_threadsafe(run(), self.loop).result()
+
+    def _stop(self) -> None:
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self._thread.join(5.0)
+        self.loop.close()
+
+    def close(self) -> None:
+        try:
+            self.call(self.bus.close)
+        finally:
+            self._stop()

@@ -20,7 +20,7 @@ from tests.integration.livestack import (
     run,
     zenav,
 )
-from zenav.bag import MsgpackDecoderFactory, read_bag, recorded_robot
+from zenav.bag.mcapfile import MsgpackDecoderFactory, read_bag, recorded_robot
 from zenav.launch import free_port_block
 from zenav.schemas.codec import decode
 from zenav.schemas.messages import (

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from zenav.bag import BagWriter, MsgpackDecoderFactory, read_bag, recorded_robot
+from zenav.bag.mcapfile import BagWriter, MsgpackDecoderFactory, read_bag, recorded_robot
 from zenav.schemas.codec import encode
 from zenav.schemas.messages import Odometry, Pose2D, ServiceStatus, VelocityCommand
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from rich.console import Console
 
-from zenav.monitor import LatencyMeter, MonitorModel, RateMeter, render
+from zenav.monitor.model import LatencyMeter, MonitorModel, RateMeter
+from zenav.monitor.screen import render
 from zenav.schemas.codec import encode
 from zenav.schemas.messages import (
     BaseCommand,

@@ -1,0 +1,115 @@
+"""``zenav replay``: the messages of an MCAP file published again, at the recorded pace."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from zenav.bag.mcapfile import read_bag, recorded_robot
+from zenav.schemas.keys import Keys
+from zenav.services.config import ConfigError
+from zenav.services.runner import add_transport_arguments
+from zenav.services.transport import ZenohBus
+from zenav.tooling import stop_on_signals, tool_transport, wait_for_event
+
+
+async def replay(transport: Any, path: Path, *, rate: float, topics: set[str] | None,
+                 as_robot: str | None, wait_for: list[str], timeout: float) -> int:
+    """Publish the file's messages again; the number published."""
+    if rate <= 0:
+        raise ValueError(f"--rate must be > 0 (got {rate})")
+    source = recorded_robot(path)
+    target = Keys(as_robot or source)
+    loop = asyncio.get_running_loop()
+    stop = asyncio.Event()
+    stop_on_signals(stop)
+    bus = ZenohBus(transport, loop)
+    published = 0
+    try:
+        if wait_for:
+            alive: set[str] = set()
+            changed = asyncio.Event()
+
+            def on_liveliness(key: str, is_alive: bool) -> None:
+                service = key.rsplit("/", 1)[-1]
+                (alive.add if is_alive else alive.discard)(service)
+                changed.set()
+
+            bus.watch_liveliness(target.alive_any, on_liveliness)
+            deadline = loop.time() + timeout
+            while missing := set(wait_for) - alive:
+                left = deadline - loop.time()
+                if left <= 0:
+                    raise TimeoutError(f"not alive after {timeout:.0f} s: "
+                                       f"{', '.join(sorted(missing))}")
+                changed.clear()
+                await wait_for_event(changed, left)
+        publishers: dict[str, Any] = {}
+        start_wall: float | None = None
+        start_log = 0
+        for item in read_bag(path, topics):
+            if stop.is_set():
+                break
+            if start_wall is None:
+                start_wall, start_log = loop.time(), item.log_time
+            due = start_wall + (item.log_time - start_log) / 1e9 / rate
+            delay = due - loop.time()
+            if delay > 0 and await wait_for_event(stop, delay):
+                break
+            key = f"{target.prefix}/{item.topic}"
+            publisher = publishers.get(key)
+            if publisher is None:
+                publisher = publishers[key] = bus.publisher(key, reliable=True)
+            publisher.put(item.payload)
+            published += 1
+        await asyncio.sleep(0.2)  # let the last messages leave before the session closes
+    finally:
+        bus.close()
+    return published
+
+
+
+def main(args: argparse.Namespace) -> int:
+    topics = {t.strip() for t in args.topics.split(",") if t.strip()} or None
+    wait_for = [s.strip() for s in args.wait_for.split(",") if s.strip()]
+    try:
+        transport = tool_transport(args)
+        if args.as_robot is not None:
+            Keys(args.as_robot)
+        started = time.monotonic()
+        count = asyncio.run(replay(transport, args.file, rate=args.rate, topics=topics,
+                                   as_robot=args.as_robot, wait_for=wait_for,
+                                   timeout=args.timeout))
+    except TimeoutError as exc:  # before OSError, of which it is a subclass
+        print(f"zenav replay: {exc}", file=sys.stderr)
+        return 1
+    except (ConfigError, ValueError, OSError) as exc:
+        print(f"zenav replay: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 0
+    print(f"zenav replay: {count} messages in {time.monotonic() - started:.1f} s "
+          f"at rate {args.rate:g}", flush=True)
+    return 0
+
+
+
+def add_command(sub: Any) -> None:
+    replay = sub.add_parser("replay", help="publish a recorded MCAP file again")
+    replay.add_argument("file", type=Path)
+    replay.add_argument("--rate", type=float, default=1.0,
+                        help="speed-up over the recorded timing (default 1: as recorded)")
+    replay.add_argument("--topics", default="",
+                        help="comma-separated topics to publish, e.g. scan,odom (default all)")
+    replay.add_argument("--as-robot", metavar="ID",
+                        help="publish under this robot id instead of the recorded one")
+    replay.add_argument("--wait-for", default="", metavar="SERVICES",
+                        help="comma-separated services whose liveliness is awaited first")
+    replay.add_argument("--timeout", type=float, default=30.0,
+                        help="s to wait for --wait-for (default 30)")
+    add_transport_arguments(replay)
+    replay.set_defaults(func=main)

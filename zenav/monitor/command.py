@@ -1,0 +1,88 @@
+"""``zenav monitor``: the process that feeds a :class:`MonitorModel` from the bus and
+shows it as a screen or as JSON lines."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import json
+import sys
+import time
+from typing import IO, Any
+
+from zenav.monitor.model import MonitorModel
+from zenav.monitor.screen import render
+from zenav.services.runner import add_transport_arguments
+from zenav.services.transport import ZenohBus
+from zenav.tooling import StampedSubscriber, stop_on_signals, tool_setup, wait_for_event
+
+
+async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
+                  duration: float | None, silence: float = 0.5,
+                  out: IO[str] = sys.stdout) -> None:
+    model = MonitorModel(robot_id, silence_after=silence)
+    loop = asyncio.get_running_loop()
+    stop = asyncio.Event()
+    stop_on_signals(stop)
+    if duration is not None:
+        loop.call_later(duration, stop.set)
+    bus = ZenohBus(transport, loop)
+    subscriber = StampedSubscriber(
+        bus, model.keys.everything,
+        lambda key, payload, ns: model.on_sample(key, payload, ns / 1e9))
+    bus.watch_liveliness(model.keys.alive_any,
+                         lambda key, alive: model.on_liveliness(key, alive, time.time()))
+    try:
+        if jsonl:
+            while not stop.is_set():
+                now = time.time()
+                model.tick(now)
+                for event in model.drain_events():
+                    out.write(json.dumps(event.as_dict()) + "\n")
+                out.write(json.dumps(model.snapshot(now)) + "\n")
+                out.flush()
+                await wait_for_event(stop, period)
+        else:
+            from rich.live import Live
+
+            with Live(render(model, time.time()), refresh_per_second=max(1, round(1 / period)),
+                      screen=False) as live:
+                while not stop.is_set():
+                    now = time.time()
+                    model.tick(now)
+                    model.drain_events()  # shown in "recent events"
+                    live.update(render(model, now))
+                    await wait_for_event(stop, period)
+    finally:
+        subscriber.close()
+        bus.close()
+
+
+def main(args: argparse.Namespace) -> int:
+    setup = tool_setup(args, "monitor")
+    if setup is None:
+        return 2
+    robot_id, transport = setup
+    with contextlib.suppress(KeyboardInterrupt):
+        asyncio.run(monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
+                            duration=args.duration, silence=args.silence))
+    return 0
+
+
+def add_command(sub: Any) -> None:
+    monitor = sub.add_parser(
+        "monitor", help="live read-only view of a running stack",
+        description="Live view: robot pose and speed, obstacles, the planner's scenario and "
+        "action, each service's liveliness, message rates, scan-to-command latency. "
+        "--connect ENDPOINT joins a router as a client from any host.")
+    monitor.add_argument("--jsonl", action="store_true",
+                         help="print events and snapshots as JSON lines, not a screen")
+    monitor.add_argument("--period", type=float, default=0.25,
+                         help="s between screen refreshes or snapshots (default 0.25)")
+    monitor.add_argument("--duration", type=float, help="stop after this many s")
+    monitor.add_argument("--silence", type=float, default=0.5,
+                         help="a topic silent this long (s, at least 4 typical gaps) counts "
+                         "as stopped (default 0.5)")
+    add_transport_arguments(monitor)
+    monitor.set_defaults(func=main)
