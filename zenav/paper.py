@@ -8,20 +8,18 @@ computed from a ``run.json`` by :func:`indicators`.
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import statistics
-import threading
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass
+import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
-from zenav.run import run_scenario
+from zenav.batch import Job, run_batch
 from zenav.sim import SCENARIO_DIR
 from zenav.sim.scenario import Scenario, load_scenario
 
@@ -42,18 +40,6 @@ SIMULATIONS = ("paper-static", "paper-dynamic", "paper-mixed")
 ROBUSTNESS = "paper-robustness"
 NOISE_STD = 0.01
 SEEDS = (1, 2, 3)
-
-_plot_lock = threading.Lock()  # pyplot keeps global state: one figure at a time
-
-
-@dataclass(frozen=True)
-class Job:
-    """One run of the report."""
-
-    key: str  # e.g. "a/seed1", "paper-mixed"
-    scenario: Path
-    out: Path
-
 
 def indicators(record: dict[str, Any], scenario: Scenario) -> dict[str, float]:
     """The paper's performance indicators for one run, from its run record alone.
@@ -112,175 +98,6 @@ def plan_jobs(out: Path, quick: bool = False) -> list[Job]:
     return jobs
 
 
-def run_jobs(
-    jobs: list[Job], parallel: int, on_done: Callable[[Job], None]
-) -> dict[str, dict[str, Any]]:
-    """Run every job through the full stack, ``parallel`` at a time."""
-
-    def one(job: Job) -> tuple[str, dict[str, Any]]:
-        record = run_scenario(job.scenario, job.out, picture=False)
-        with _plot_lock:  # pyplot keeps global state: one figure at a time
-            from zenav.plot import plot_run
-
-            plot_run(load_scenario(job.scenario), record, job.out / "run.png")
-        return job.key, record
-
-    records: dict[str, dict[str, Any]] = {}
-    with ThreadPoolExecutor(parallel) as pool:
-        futures = {pool.submit(one, job): job for job in jobs}
-        for future in as_completed(futures):
-            key, record = future.result()
-            records[key] = record
-            on_done(futures[future])
-    return records
-
-
-# --- figures -------------------------------------------------------------------------
-
-
-def _decision_points(record: dict[str, Any]) -> list[tuple[float, float, float, str]]:
-    """(t, x, y, label) of every event that is not plain driving."""
-    traj = record["trajectory"]
-    times = [row[0] for row in traj]
-    found = []
-    for event in record["events"]:
-        if event["action"] in ("keep", "resume") and event["scenario"] in "a":
-            continue
-        i = min(range(len(times)), key=lambda k: abs(times[k] - event["t"]))
-        found.append((event["t"], traj[i][1], traj[i][2],
-                      f"{event['scenario']}:{event['action']}"))
-    return found
-
-
-def draw_experiment(scenario: Scenario, record: dict[str, Any], path: Path,
-                    window_radius: float, title: str) -> None:
-    """The paper-style figure: grid, obstacles and movers' paths, global path,
-    trajectory, the sliding windows where decisions happened (V1..) and the decision
-    points with their scenario letter and action."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Rectangle
-
-    width, height = scenario.world.size
-    end = float(record["time"])
-    with _plot_lock:
-        fig, ax = plt.subplots(figsize=(7.5, 7.5 * height / width))
-        ax.set_xlim(0, width)
-        ax.set_ylim(0, height)
-        ax.set_aspect("equal")
-        cell = scenario.world.cell
-        ax.set_xticks(np.arange(0, width + 1e-9, cell), minor=True)
-        ax.set_yticks(np.arange(0, height + 1e-9, cell), minor=True)
-        ax.grid(which="minor", color="0.9", linewidth=0.5)
-        traj_all = np.asarray(record["trajectory"])
-        for index, ob in enumerate(scenario.obstacles):
-            moving = not ob.is_static
-            colour = "tab:purple" if moving else "0.35"
-            if moving:
-                t0, t1 = ob.appear, min(ob.vanish_time, end)
-                stops = np.linspace(t0, max(t0, t1 - 1e-6), 60)
-                path_xy = np.array([ob.center_at(t) for t in stops])
-                ax.plot(path_xy[:, 0], path_xy[:, 1], ls=":", color=colour, lw=1)
-                # drawn where it came closest to the robot, with its heading
-                robot_at = np.array([np.interp(stops, traj_all[:, 0], traj_all[:, 1]),
-                                     np.interp(stops, traj_all[:, 0], traj_all[:, 2])]).T
-                k = int(np.argmin(np.hypot(*(path_xy - robot_at).T)))
-                cx, cy = path_xy[k]
-                tip = path_xy[min(k + 3, len(path_xy) - 1)]
-                ax.annotate("", xy=tuple(tip), xytext=(cx, cy),
-                            arrowprops={"arrowstyle": "->", "color": colour})
-            else:
-                cx, cy = ob.center
-            if ob.shape == "disc" and ob.radius is not None:
-                ax.add_patch(Circle((cx, cy), ob.radius, color=colour, alpha=0.75))
-            elif ob.size is not None:
-                ax.add_patch(Rectangle((cx - ob.size[0] / 2, cy - ob.size[1] / 2), ob.size[0],
-                                       ob.size[1], color=colour, alpha=0.75))
-            label = f"{'D' if moving else 'S'}{index}"
-            ax.annotate(label, (cx, cy), xytext=(3, 3), textcoords="offset points", fontsize=7)
-        start, goal = scenario.robot.start, scenario.robot.goal
-        ax.plot([start[0], goal[0]], [start[1], goal[1]], ls="--", color="tab:green", lw=1,
-                label="global path")
-        traj = np.asarray(record["trajectory"])
-        ax.plot(traj[:, 1], traj[:, 2], color="tab:blue", lw=1.6, label="trajectory")
-        points = _decision_points(record)
-        windows: list[tuple[float, float]] = []
-        for _, x, y, label in points:  # the windows where decisions happened, spaced out
-            if label.split(":")[1] in ("morphin", "stop", "slow", "speed_up") and all(
-                    math.dist((x, y), w) > window_radius / 2 for w in windows):
-                windows.append((x, y))
-        for k, (x, y) in enumerate(windows[:4]):
-            ax.add_patch(Circle((x, y), window_radius, fill=False, ls="--", color="tab:orange",
-                                lw=0.8))
-            ax.annotate(f"V{k + 1}", (x + window_radius * 0.7, y + window_radius * 0.7),
-                        color="tab:orange", fontsize=8)
-        for _, x, y, label in points:
-            ax.plot(x, y, marker="x", color="tab:red", markersize=6)
-            ax.annotate(label, (x, y), xytext=(4, -9), textcoords="offset points", fontsize=7,
-                        color="tab:red")
-        ax.plot(*start, marker="o", color="tab:green")
-        ax.plot(*goal, marker="*", markersize=12, color="tab:green")
-        ax.set_title(f"{title}: {record['outcome']} at {end:.1f} s (simulated)", fontsize=10)
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.legend(loc="lower right", fontsize=7)
-        fig.tight_layout()
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-
-
-def draw_animation(scenario: Scenario, record: dict[str, Any], path: Path,
-                   window_radius: float, fps: int = 8, seconds_per_frame: float = 1.0) -> None:
-    """An animated GIF of the run: obstacles where they were, the robot and its window."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation, PillowWriter
-    from matplotlib.patches import Circle, Rectangle
-
-    traj = np.asarray(record["trajectory"])
-    frames = np.arange(0.0, float(record["time"]) + 1e-9, seconds_per_frame)
-    width, height = scenario.world.size
-    with _plot_lock:
-        fig, ax = plt.subplots(figsize=(5, 5 * height / width))
-
-        def draw(t: float) -> None:
-            ax.clear()
-            ax.set_xlim(0, width)
-            ax.set_ylim(0, height)
-            ax.set_aspect("equal")
-            ax.plot([scenario.robot.start[0], scenario.robot.goal[0]],
-                    [scenario.robot.start[1], scenario.robot.goal[1]], ls="--",
-                    color="tab:green", lw=0.8)
-            for ob in scenario.obstacles:
-                if not ob.exists_at(t):
-                    continue
-                cx, cy = ob.center_at(t)
-                colour = "0.35" if ob.is_static else "tab:purple"
-                if ob.shape == "disc" and ob.radius is not None:
-                    ax.add_patch(Circle((cx, cy), ob.radius, color=colour))
-                elif ob.size is not None:
-                    ax.add_patch(Rectangle((cx - ob.size[0] / 2, cy - ob.size[1] / 2),
-                                           ob.size[0], ob.size[1], color=colour))
-            i = int(np.searchsorted(traj[:, 0], t, side="right")) - 1
-            i = max(0, min(i, len(traj) - 1))
-            ax.plot(traj[: i + 1, 1], traj[: i + 1, 2], color="tab:blue", lw=1.2)
-            x, y, heading = traj[i, 1], traj[i, 2], traj[i, 3]
-            ax.add_patch(Circle((x, y), scenario.robot.radius, color="tab:blue", alpha=0.8))
-            ax.add_patch(Circle((x, y), window_radius, fill=False, ls="--", color="tab:orange",
-                                lw=0.8))
-            ax.plot([x, x + 0.4 * math.cos(heading)], [y, y + 0.4 * math.sin(heading)],
-                    color="k", lw=1)
-            ax.set_title(f"{scenario.name}  t = {t:5.1f} s", fontsize=9)
-
-        animation = FuncAnimation(fig, draw, frames=frames)
-        animation.save(path, writer=PillowWriter(fps=fps))
-        plt.close(fig)
-
-
 # --- report --------------------------------------------------------------------------
 
 
@@ -329,8 +146,10 @@ def indicator_table(
 
 
 def decision_list(record: dict[str, Any]) -> list[str]:
+    from zenav.plot import decision_points
+
     return [f"- t = {t:.1f} s at ({x:.2f}, {y:.2f}): {label}"
-            for t, x, y, label in _decision_points(record)]
+            for t, x, y, label in decision_points(record)]
 
 
 def write_report(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]],
@@ -371,6 +190,8 @@ def write_report(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]],
 
 
 def make_figures(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]]) -> None:
+    from zenav.plot import draw_animation, draw_experiment
+
     figures = out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
     for job in jobs:
@@ -387,15 +208,9 @@ def machine_description() -> str:
     import os
     import platform
 
-    model = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores ({model}), Python {platform.python_version()}"
+    from zenav.bench.common import cpu_model
+
+    return f"{os.cpu_count()} cores ({cpu_model()}), Python {platform.python_version()}"
 
 
 def main(out: Path, quick: bool = False, parallel: int = 2) -> Path:
@@ -411,11 +226,32 @@ def main(out: Path, quick: bool = False, parallel: int = 2) -> Path:
                   TimeElapsedColumn()) as progress:
         task = progress.add_task("", total=len(jobs) + 1)
 
-        def done(job: Job) -> None:
+        def done(job: Job, record: dict[str, Any]) -> None:
             progress.update(task, advance=1, description=job.key)
 
-        records = run_jobs(jobs, parallel, done)
+        records = run_batch(jobs, parallel, done)
         progress.update(task, description="figures")
         make_figures(out, jobs, records)
         progress.update(task, advance=1, description="report")
     return write_report(out, jobs, records, machine_description(), time.monotonic() - started)
+
+
+def _command(args: argparse.Namespace) -> int:
+    from zenav.run import RunError
+
+    try:
+        report = main(args.out, quick=args.quick, parallel=args.parallel)
+    except RunError as exc:
+        print(f"zenav paper: {exc}", file=sys.stderr)
+        return 1
+    print(f"report: {report}")
+    return 0
+
+
+def add_command(sub: Any) -> None:
+    paper = sub.add_parser("paper", help="reproduce the paper's experiments as a report")
+    paper.add_argument("--out", type=Path, default=Path("out/paper"), help="report directory")
+    paper.add_argument("--quick", action="store_true",
+                       help="scenario (a) once only (a smoke test of the report)")
+    paper.add_argument("--parallel", type=int, default=2, help="runs at once (default 2)")
+    paper.set_defaults(func=_command)

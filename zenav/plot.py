@@ -1,8 +1,15 @@
-"""The picture of a run: world, obstacles, global path, trajectory and decisions."""
+"""Report plotting: the picture of a run (``run.png``), the figures of ``zenav paper``
+(the paper-style figure and the animation) and the chart of ``zenav bench nav``.
+
+pyplot keeps global state, so every drawing function here holds :data:`PLOT_LOCK`: runs
+drawn from several threads (the batch runner) draw one figure at a time.
+"""
 
 from __future__ import annotations
 
 import math
+import threading
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -10,71 +17,256 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import numpy as np
 from matplotlib.patches import Circle, Rectangle
 
-from zenav.sim.scenario import Scenario
+from zenav.sim.scenario import ObstacleSpec, Scenario
 
 OUTCOME_COLOURS = {"reached": "tab:green", "collision": "tab:red", "timeout": "tab:orange"}
+STATIC_COLOUR = "0.35"
+MOVER_COLOUR = "tab:purple"
+
+PLOT_LOCK = threading.RLock()
+"""Held while a figure is drawn (pyplot is not thread-safe)."""
+
+
+def draw_obstacle(ax: Any, ob: ObstacleSpec, centre: Sequence[float], colour: str,
+                  alpha: float | None = None) -> None:
+    """One obstacle, a disc or a box, at ``centre``."""
+    cx, cy = float(centre[0]), float(centre[1])
+    if ob.shape == "disc" and ob.radius is not None:
+        ax.add_patch(Circle((cx, cy), ob.radius, color=colour, alpha=alpha))
+    elif ob.size is not None:
+        ax.add_patch(Rectangle((cx - ob.size[0] / 2, cy - ob.size[1] / 2), ob.size[0],
+                               ob.size[1], color=colour, alpha=alpha))
+
+
+def _world(ax: Any, scenario: Scenario, grid_colour: str | None, max_cells: int = 0) -> None:
+    """Limits, equal aspect and (with ``grid_colour``) the grid's cells as minor ticks,
+    unless the world has more than ``max_cells`` cells a side (0: no limit)."""
+    width, height = scenario.world.size
+    ax.set_xlim(0, width)
+    ax.set_ylim(0, height)
+    ax.set_aspect("equal")
+    cell = scenario.world.cell
+    if grid_colour is None or (max_cells and max(width, height) / cell > max_cells):
+        return
+    ax.set_xticks(np.arange(0, width + 1e-9, cell), minor=True)
+    ax.set_yticks(np.arange(0, height + 1e-9, cell), minor=True)
+    ax.grid(which="minor", color=grid_colour, linewidth=0.5)
+
+
+def _global_path(ax: Any, scenario: Scenario, lw: float = 1, label: str | None = None) -> None:
+    start, goal = scenario.robot.start, scenario.robot.goal
+    ax.plot([start[0], goal[0]], [start[1], goal[1]], ls="--", color="tab:green", lw=lw,
+            label=label)
+
+
+def _finish(fig: Any, ax: Any, path: Path, legend: str) -> None:
+    """Axis labels and legend; write ``path`` and close the figure."""
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc=legend, fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _nearest_rows(record: dict[str, Any], t: float) -> int:
+    times = [row[0] for row in record["trajectory"]]
+    return min(range(len(times)), key=lambda k: abs(times[k] - t))
+
+
+# --- run.png ------------------------------------------------------------------------------
 
 
 def plot_run(scenario: Scenario, record: dict[str, Any], path: Path) -> None:
     """Write ``path`` (PNG) for a run record as written to run.json."""
     width, height = scenario.world.size
-    fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
-    ax.set_xlim(0, width)
-    ax.set_ylim(0, height)
-    ax.set_aspect("equal")
-    cell = scenario.world.cell
-    if width / cell <= 60 and height / cell <= 60:
-        ax.set_xticks([i * cell for i in range(int(width / cell) + 1)], minor=True)
-        ax.set_yticks([i * cell for i in range(int(height / cell) + 1)], minor=True)
-        ax.grid(which="minor", color="0.92", linewidth=0.5)
-    end = float(record["time"])
-    for index, ob in enumerate(scenario.obstacles):
-        moving = ob.velocity is not None and any(ob.velocity)
-        colour = "tab:purple" if moving else "0.35"
-        t_show = max(ob.appear, min(end, ob.vanish_time - 1e-6))
-        cx, cy = ob.center_at(t_show) if moving else ob.center
-        if ob.shape == "disc":
-            assert ob.radius is not None
-            patch: Any = Circle((cx, cy), ob.radius, color=colour, alpha=0.7)
-        else:
-            assert ob.size is not None
-            patch = Rectangle((cx - ob.size[0] / 2, cy - ob.size[1] / 2), ob.size[0], ob.size[1],
-                              color=colour, alpha=0.7)
-        ax.add_patch(patch)
-        if moving:
-            x0, y0 = ob.center
-            ax.plot([x0, cx], [y0, cy], ls=":", color=colour, lw=1)
-        ax.annotate(str(index), (cx, cy), ha="center", va="center", fontsize=7, color="white")
-    start, goal = scenario.robot.start, scenario.robot.goal
-    ax.plot([start[0], goal[0]], [start[1], goal[1]], ls="--", color="tab:green", lw=1,
-            label="global path")
+    with PLOT_LOCK:
+        fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
+        _world(ax, scenario, "0.92", max_cells=60)
+        end = float(record["time"])
+        for index, ob in enumerate(scenario.obstacles):
+            moving = ob.velocity is not None and any(ob.velocity)
+            colour = MOVER_COLOUR if moving else STATIC_COLOUR
+            t_show = max(ob.appear, min(end, ob.vanish_time - 1e-6))
+            cx, cy = ob.center_at(t_show) if moving else ob.center
+            draw_obstacle(ax, ob, (cx, cy), colour, alpha=0.7)
+            if moving:
+                x0, y0 = ob.center
+                ax.plot([x0, cx], [y0, cy], ls=":", color=colour, lw=1)
+            ax.annotate(str(index), (cx, cy), ha="center", va="center", fontsize=7,
+                        color="white")
+        start, goal = scenario.robot.start, scenario.robot.goal
+        _global_path(ax, scenario, label="global path")
+        traj = record["trajectory"]
+        xs = [row[1] for row in traj]
+        ys = [row[2] for row in traj]
+        outcome = record["outcome"]
+        ax.plot(xs, ys, color="tab:blue", lw=1.5, label="trajectory")
+        ax.add_patch(Circle((xs[-1], ys[-1]), scenario.robot.radius, fill=False,
+                            color=OUTCOME_COLOURS.get(outcome, "k"), lw=1.5))
+        ax.plot(*start, marker="o", color="tab:green")
+        ax.plot(*goal, marker="*", markersize=12, color="tab:green")
+        ax.add_patch(Circle(goal, scenario.robot.goal_tolerance, fill=False, ls=":",
+                            color="tab:green"))
+        for event in record["events"]:
+            i = _nearest_rows(record, event["t"])
+            ax.plot(xs[i], ys[i], marker="x", color="tab:red", markersize=6)
+            ax.annotate(f"{event['scenario']}:{event['action']}", (xs[i], ys[i]),
+                        textcoords="offset points", xytext=(4, 4), fontsize=7, color="tab:red")
+        clearance = record.get("min_clearance")
+        clearance_text = ("-" if clearance is None or math.isinf(clearance)
+                          else f"{clearance:.2f} m")
+        ax.set_title(f"{record['scenario']} ({record['planner']}): {outcome} at {end:.1f} s, "
+                     f"path {record['path_length']:.2f} m, min clearance {clearance_text}",
+                     fontsize=9)
+        _finish(fig, ax, path, "upper left")
+
+
+# --- zenav paper --------------------------------------------------------------------------
+
+
+def decision_points(record: dict[str, Any]) -> list[tuple[float, float, float, str]]:
+    """(t, x, y, label) of every event that is not plain driving."""
     traj = record["trajectory"]
-    xs = [row[1] for row in traj]
-    ys = [row[2] for row in traj]
-    outcome = record["outcome"]
-    ax.plot(xs, ys, color="tab:blue", lw=1.5, label="trajectory")
-    ax.add_patch(Circle((xs[-1], ys[-1]), scenario.robot.radius, fill=False,
-                        color=OUTCOME_COLOURS.get(outcome, "k"), lw=1.5))
-    ax.plot(*start, marker="o", color="tab:green")
-    ax.plot(*goal, marker="*", markersize=12, color="tab:green")
-    goal_circle = Circle(goal, scenario.robot.goal_tolerance, fill=False, ls=":", color="tab:green")
-    ax.add_patch(goal_circle)
-    times = [row[0] for row in traj]
+    found = []
     for event in record["events"]:
-        i = min(range(len(times)), key=lambda k: abs(times[k] - event["t"]))
-        ax.plot(xs[i], ys[i], marker="x", color="tab:red", markersize=6)
-        ax.annotate(f"{event['scenario']}:{event['action']}", (xs[i], ys[i]),
-                    textcoords="offset points", xytext=(4, 4), fontsize=7, color="tab:red")
-    clearance = record.get("min_clearance")
-    clearance_text = "-" if clearance is None or math.isinf(clearance) else f"{clearance:.2f} m"
-    ax.set_title(f"{record['scenario']} ({record['planner']}): {outcome} at {end:.1f} s, "
-                 f"path {record['path_length']:.2f} m, min clearance {clearance_text}",
-                 fontsize=9)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.legend(loc="upper left", fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+        if event["action"] in ("keep", "resume") and event["scenario"] in "a":
+            continue
+        i = _nearest_rows(record, event["t"])
+        found.append((event["t"], traj[i][1], traj[i][2],
+                      f"{event['scenario']}:{event['action']}"))
+    return found
+
+
+def _mover_track(ax: Any, ob: ObstacleSpec, end: float, traj: np.ndarray, colour: str
+                 ) -> tuple[float, float]:
+    """A mover's path, dotted, with an arrow where it came closest to the robot; that
+    place."""
+    t0, t1 = ob.appear, min(ob.vanish_time, end)
+    stops = np.linspace(t0, max(t0, t1 - 1e-6), 60)
+    path_xy = np.array([ob.center_at(t) for t in stops])
+    ax.plot(path_xy[:, 0], path_xy[:, 1], ls=":", color=colour, lw=1)
+    robot_at = np.array([np.interp(stops, traj[:, 0], traj[:, 1]),
+                         np.interp(stops, traj[:, 0], traj[:, 2])]).T
+    k = int(np.argmin(np.hypot(*(path_xy - robot_at).T)))
+    cx, cy = path_xy[k]
+    tip = path_xy[min(k + 3, len(path_xy) - 1)]
+    ax.annotate("", xy=tuple(tip), xytext=(cx, cy),
+                arrowprops={"arrowstyle": "->", "color": colour})
+    return float(cx), float(cy)
+
+
+def draw_experiment(scenario: Scenario, record: dict[str, Any], path: Path,
+                    window_radius: float, title: str) -> None:
+    """The paper-style figure: grid, obstacles and movers' paths, global path,
+    trajectory, the sliding windows where decisions happened (V1..) and the decision
+    points with their scenario letter and action."""
+    width, height = scenario.world.size
+    end = float(record["time"])
+    traj = np.asarray(record["trajectory"])
+    with PLOT_LOCK:
+        fig, ax = plt.subplots(figsize=(7.5, 7.5 * height / width))
+        _world(ax, scenario, "0.9")
+        for index, ob in enumerate(scenario.obstacles):
+            moving = not ob.is_static
+            colour = MOVER_COLOUR if moving else STATIC_COLOUR
+            cx, cy = _mover_track(ax, ob, end, traj, colour) if moving else ob.center
+            draw_obstacle(ax, ob, (cx, cy), colour, alpha=0.75)
+            label = f"{'D' if moving else 'S'}{index}"
+            ax.annotate(label, (cx, cy), xytext=(3, 3), textcoords="offset points", fontsize=7)
+        start, goal = scenario.robot.start, scenario.robot.goal
+        _global_path(ax, scenario, label="global path")
+        ax.plot(traj[:, 1], traj[:, 2], color="tab:blue", lw=1.6, label="trajectory")
+        points = decision_points(record)
+        windows: list[tuple[float, float]] = []
+        for _, x, y, label in points:  # the windows where decisions happened, spaced out
+            if label.split(":")[1] in ("morphin", "stop", "slow", "speed_up") and all(
+                    math.dist((x, y), w) > window_radius / 2 for w in windows):
+                windows.append((x, y))
+        for k, (x, y) in enumerate(windows[:4]):
+            ax.add_patch(Circle((x, y), window_radius, fill=False, ls="--", color="tab:orange",
+                                lw=0.8))
+            ax.annotate(f"V{k + 1}", (x + window_radius * 0.7, y + window_radius * 0.7),
+                        color="tab:orange", fontsize=8)
+        for _, x, y, label in points:
+            ax.plot(x, y, marker="x", color="tab:red", markersize=6)
+            ax.annotate(label, (x, y), xytext=(4, -9), textcoords="offset points", fontsize=7,
+                        color="tab:red")
+        ax.plot(*start, marker="o", color="tab:green")
+        ax.plot(*goal, marker="*", markersize=12, color="tab:green")
+        ax.set_title(f"{title}: {record['outcome']} at {end:.1f} s (simulated)", fontsize=10)
+        _finish(fig, ax, path, "lower right")
+
+
+def draw_animation(scenario: Scenario, record: dict[str, Any], path: Path,
+                   window_radius: float, fps: int = 8, seconds_per_frame: float = 1.0) -> None:
+    """An animated GIF of the run: obstacles where they were, the robot and its window."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    traj = np.asarray(record["trajectory"])
+    frames = np.arange(0.0, float(record["time"]) + 1e-9, seconds_per_frame)
+    width, height = scenario.world.size
+    with PLOT_LOCK:
+        fig, ax = plt.subplots(figsize=(5, 5 * height / width))
+
+        def draw(t: float) -> None:
+            ax.clear()
+            _world(ax, scenario, None)
+            _global_path(ax, scenario, lw=0.8)
+            for ob in scenario.obstacles:
+                if ob.exists_at(t):
+                    draw_obstacle(ax, ob, ob.center_at(t),
+                                  STATIC_COLOUR if ob.is_static else MOVER_COLOUR)
+            i = int(np.searchsorted(traj[:, 0], t, side="right")) - 1
+            i = max(0, min(i, len(traj) - 1))
+            ax.plot(traj[: i + 1, 1], traj[: i + 1, 2], color="tab:blue", lw=1.2)
+            x, y, heading = traj[i, 1], traj[i, 2], traj[i, 3]
+            ax.add_patch(Circle((x, y), scenario.robot.radius, color="tab:blue", alpha=0.8))
+            ax.add_patch(Circle((x, y), window_radius, fill=False, ls="--", color="tab:orange",
+                                lw=0.8))
+            ax.plot([x, x + 0.4 * math.cos(heading)], [y, y + 0.4 * math.sin(heading)],
+                    color="k", lw=1)
+            ax.set_title(f"{scenario.name}  t = {t:5.1f} s", fontsize=9)
+
+        animation = FuncAnimation(fig, draw, frames=frames)
+        animation.save(path, writer=PillowWriter(fps=fps))
+        plt.close(fig)
+
+
+# --- zenav bench nav ----------------------------------------------------------------------
+
+OUTCOME_BARS = (("reached", "#3a923a"), ("timeout", "#e0a030"), ("collision", "#c83737"))
+
+
+def draw_bench_chart(planners: Sequence[str], outcomes: dict[str, list[float]],
+                     success: dict[str, list[float]], path: Path) -> None:
+    """Left, stacked bars of each planner's outcomes (``outcomes[outcome]``: share of runs
+    per planner, NaN for none); right, grouped bars of success per world family
+    (``success[family]``: % per planner)."""
+    with PLOT_LOCK:
+        fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.5))
+        bottom = [0.0] * len(planners)
+        for label, colour in OUTCOME_BARS:
+            shown = [0.0 if math.isnan(v) else 100 * v for v in outcomes[label]]
+            left.bar(planners, shown, bottom=bottom, color=colour, label=label)
+            bottom = [b + v for b, v in zip(bottom, shown, strict=True)]
+        left.set_ylabel("runs, %")
+        left.set_title("outcome per planner, all worlds")
+        left.legend(loc="lower right")
+        names = list(success)
+        width = 0.8 / max(len(planners), 1)
+        for i, p in enumerate(planners):
+            rates = [success[f][i] for f in names]
+            right.bar([k + i * width for k in range(len(names))], rates, width=width, label=p)
+        right.set_xticks([k + width * (len(planners) - 1) / 2 for k in range(len(names))])
+        right.set_xticklabels(names)
+        right.set_ylabel("success, %")
+        right.set_ylim(0, 105)
+        right.set_title("success per world family")
+        right.legend(loc="lower right", fontsize="small")
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
