@@ -1,32 +1,38 @@
-"""The whole pipeline in one process, without the bus: for debugging and benchmarks.
+"""The whole pipeline in one process, without the bus: for debugging, benchmarks and tests.
 
-It calls the same pure cores the services call, in the same order and with the same
-parameters as ``zenav run`` (simulator -> laser driver -> perception -> tracking ->
-planner -> motor bridge), so a lockstep run here follows the same trajectory as one
-through the processes. The acceptance path is still ``zenav run``: this module skips
-the transport, the codec and the processes.
+:class:`Pipeline` holds the pure cores the services call (laser driver -> perception ->
+tracking -> planner -> motor bridge), set up with the same parameters as ``zenav run``,
+and runs them on one scan at a time. :func:`run_inprocess` drives it with the simulator,
+so a lockstep run here follows the same trajectory as one through the processes.
+``zenav bench perf`` times it stage by stage with a :class:`StageClock`. The acceptance
+path is still ``zenav run``: this module skips the transport, the codec and the processes.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from zenav.run import apply_override, stack_params
-from zenav.schemas.messages import Pose2D, RawLaserFrame, Track, TrackList
+from typing_extensions import override
+
+from zenav.run import apply_override
+from zenav.schemas.messages import LaserScan, Pose2D, RawLaserFrame, Track, TrackList
 from zenav.services.laser_driver.node import Params as DriverParams
 from zenav.services.laser_driver.node import frame_to_scan
+from zenav.services.mission import stack_params
 from zenav.services.motor_bridge.node import CommandFilter
 from zenav.services.motor_bridge.node import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
-from zenav.services.planner.decide import Decision, Planner
+from zenav.services.planner.decide import Decision, Detour, Planner
 from zenav.services.planner.node import EventLog, EventRow, obstacles_of
 from zenav.services.planner.params import Params as PlannerParams
+from zenav.services.planner.prediction import Assessment, Obstacle
 from zenav.services.tracking.node import track_message
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Tracker
@@ -35,6 +41,112 @@ from zenav.sim.node import Simulation
 from zenav.sim.scenario import load_scenario
 
 StageTimes = dict[str, list[float]]
+Pose = tuple[float, float, float]
+
+STAGES = ("perception", "tracking", "planner")
+"""The stages a :class:`Pipeline` times on its clock, in order."""
+
+
+class StageClock:
+    """Wall time spent per stage label, added up until :meth:`reset`."""
+
+    def __init__(self) -> None:
+        self.spent: dict[str, float] = {}
+        self.calls: dict[str, int] = {}
+
+    @contextmanager
+    def stage(self, label: str) -> Iterator[None]:
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.spent[label] = self.spent.get(label, 0.0) + time.perf_counter() - start
+            self.calls[label] = self.calls.get(label, 0) + 1
+
+    def reset(self) -> None:
+        self.spent.clear()
+        self.calls.clear()
+
+
+class TimedPlanner(Planner):
+    """The paper's planner with its collision prediction (``prediction``: assessing the
+    obstacles and choosing a safe speed) and Morphin (``morphin``: planning a detour)
+    timed on a clock. It decides exactly as :class:`Planner` does."""
+
+    def __init__(self, params: PlannerParams, clock: StageClock) -> None:
+        super().__init__(params)
+        self.clock = clock
+
+    @override
+    def _assess_all(self, *args: Any, **kwargs: Any) -> list[Assessment]:
+        with self.clock.stage("prediction"):
+            return super()._assess_all(*args, **kwargs)
+
+    @override
+    def safe_speed(self, *args: Any, **kwargs: Any) -> tuple[float, Obstacle | None]:
+        with self.clock.stage("prediction"):
+            return super().safe_speed(*args, **kwargs)
+
+    @override
+    def plan_detour(self, *args: Any, **kwargs: Any) -> Detour | None:
+        with self.clock.stage("morphin"):
+            return super().plan_detour(*args, **kwargs)
+
+
+@dataclass
+class Step:
+    """What each stage made of one scan."""
+
+    t: float
+    scan: LaserScan
+    clusters: Clusters
+    tracks: list[Track]
+    track_list: TrackList
+    obstacles: list[Obstacle]
+    decision: Decision
+
+
+class Pipeline:
+    """Laser driver, perception, tracking and planner (and the motor bridge's filter) as
+    the services set them up from ``params`` (per service, as :func:`stack_params` gives
+    them); each stage of :meth:`step` is timed on ``clock``, and with
+    ``time_planner_parts`` the planner's prediction and Morphin too."""
+
+    def __init__(self, params: dict[str, dict[str, Any]], clock: StageClock | None = None,
+                 *, time_planner_parts: bool = False) -> None:
+        self.clock = clock or StageClock()
+        self.driver = DriverParams.model_validate(params["laser_driver"])
+        self.perceiver = Perceiver(PerceptionParams.model_validate(params["perception"]))
+        self.tracker = Tracker(TrackingParams.model_validate(params["tracking"]))
+        self.planner_params = PlannerParams.model_validate(params["planner"])
+        self.planner = (TimedPlanner(self.planner_params, self.clock) if time_planner_parts
+                        else Planner(self.planner_params))
+        self.bridge = CommandFilter(BridgeParams.model_validate(params["motor_bridge"]))
+
+    def step(self, t: float, seq: int, ranges: Any, pose: Pose) -> Step:
+        """One scan (the simulator's ranges at ``t``, the robot at ``pose``) through the
+        laser driver, perception, tracking and the planner."""
+        scan = frame_to_scan(RawLaserFrame(stamp=t, seq=seq, ranges=ranges), self.driver, seq)
+        with self.clock.stage("perception"):
+            clusters = self.perceiver.process(scan, pose)
+        with self.clock.stage("tracking"):
+            tracks = [track_message(tr) for tr in self.tracker.update(t, pose, clusters)]
+        track_list = TrackList(stamp=t, seq=seq, pose=Pose2D(x=pose[0], y=pose[1],
+                                                             heading=pose[2]), tracks=tracks)
+        obstacles = obstacles_of(track_list)
+        with self.clock.stage("planner"):
+            decision = self.planner.step(pose, obstacles, t)
+        return Step(t, scan, clusters, tracks, track_list, obstacles, decision)
+
+
+def scenario_params(scenario_path: Path, overrides: list[str] | None = None
+                    ) -> dict[str, dict[str, Any]]:
+    """Each service's parameters for a scenario, as ``zenav run`` (paper planner) sets
+    them, with ``SERVICE.NAME=VALUE`` overrides."""
+    params = stack_params(load_scenario(scenario_path), scenario_path, "paper")
+    for text in overrides or []:
+        apply_override(params, text)
+    return params
 
 
 @dataclass
@@ -61,45 +173,26 @@ def run_inprocess(
     overrides: list[str] | None = None,
     on_cycle: Callable[[Cycle], None] | None = None,
 ) -> InProcessRun:
-    scenario = load_scenario(scenario_path)
-    params: dict[str, dict[str, Any]] = stack_params(scenario, scenario_path, "paper")
-    for text in overrides or []:
-        apply_override(params, text)
-    sim = Simulation(scenario, SimParams.model_validate(params["simulator"]))
-    driver = DriverParams.model_validate(params["laser_driver"])
-    perceiver = Perceiver(PerceptionParams.model_validate(params["perception"]))
-    tracker = Tracker(TrackingParams.model_validate(params["tracking"]))
-    planner = Planner(PlannerParams.model_validate(params["planner"]))
-    bridge = CommandFilter(BridgeParams.model_validate(params["motor_bridge"]))
-    log = EventLog(planner.p.horizon)
-    run = InProcessRun(sim)
-    times: StageTimes = {k: [] for k in ("perception", "tracking", "planner")}
-    run.stage_seconds = times
+    params = scenario_params(scenario_path, overrides)
+    sim = Simulation(load_scenario(scenario_path), SimParams.model_validate(params["simulator"]))
+    pipeline = Pipeline(params)
+    log = EventLog(pipeline.planner_params.horizon)
+    run = InProcessRun(sim, stage_seconds={k: [] for k in STAGES})
     v = omega = 0.0
     seq = 0
     while sim.outcome is None:
         if sim.scan_due():
-            t = sim.t
-            frame = RawLaserFrame(stamp=t, seq=seq, ranges=sim.scan())
-            scan = frame_to_scan(frame, driver, seq)
+            t, ranges, s = sim.t, sim.scan(), sim.state
+            pipeline.clock.reset()
+            step = pipeline.step(t, seq, ranges, (s.x, s.y, s.heading))
             seq += 1
-            s = sim.state
-            pose = (s.x, s.y, s.heading)
-            t0 = time.perf_counter()
-            clusters = perceiver.process(scan, pose)
-            t1 = time.perf_counter()
-            tracks = [track_message(tr) for tr in tracker.update(t, pose, clusters)]
-            t2 = time.perf_counter()
-            track_list = TrackList(stamp=t, seq=seq, pose=Pose2D(x=pose[0], y=pose[1],
-                                                                 heading=pose[2]), tracks=tracks)
-            decision = planner.step(pose, obstacles_of(track_list), t)
-            t3 = time.perf_counter()
-            times["perception"].append(t1 - t0)
-            times["tracking"].append(t2 - t1)
-            times["planner"].append(t3 - t2)
-            v, omega, reason = bridge.apply(t, decision.v, decision.omega, scan)
+            for stage in STAGES:
+                run.stage_seconds[stage].append(pipeline.clock.spent[stage])
+            v, omega, reason = pipeline.bridge.apply(step.t, step.decision.v,
+                                                     step.decision.omega, step.scan)
             run.zone_stops += reason == "stop_zone"
-            cycle = Cycle(t, clusters, tracks, decision, log.events(decision))
+            cycle = Cycle(step.t, step.clusters, step.tracks, step.decision,
+                          log.events(step.decision))
             run.cycles.append(cycle)
             if on_cycle is not None:
                 on_cycle(cycle)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from zenav.soak import run_soak, summary
+from zenav.bench.soak import run_soak, summary
 
 pytestmark = pytest.mark.integration
 

@@ -2,24 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import pytest
 
-BENCH = Path(__file__).resolve().parents[2] / "bench" / "tracking_accuracy.py"
+from zenav.bench import tracking_accuracy
 
 
 def load_bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("tracking_accuracy", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up by name
-    spec.loader.exec_module(module)
-    return module
+    return tracking_accuracy
 
 
 def test_smoothed_estimate_meets_the_targets_at_noise_0_01() -> None:

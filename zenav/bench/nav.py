@@ -4,7 +4,7 @@ service stack.
 Worlds come from :func:`zenav.sim.generate.random_scenario` (static clutter; crossing,
 head-on and overtaking movers; mixed; a circle-crossing crowd), ``--worlds`` of each
 family from seed ``--seed`` on, written as scenario files. Each (planner, world) is one
-``zenav run --planner P`` in a subprocess, ``--jobs`` at a time; a run whose
+run through ``zenav run``'s path (:mod:`zenav.batch`), ``--jobs`` at a time; a run whose
 ``run.json`` is already in ``--out`` is not repeated. Per planner: success, collision and
 timeout rates, mean time to goal and path length on the worlds that every planner
 solved, minimum clearance, and decisions (planner events) per run.
@@ -12,34 +12,24 @@ solved, minimum clearance, and decisions (planner events) per run.
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
+import os
 import statistics
-import subprocess
 import sys
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from zenav.bench_perf import machine
+from zenav.batch import Job, run_batch
+from zenav.bench.common import machine, words
 from zenav.sim.generate import FAMILIES, random_scenario
 from zenav.sim.scenario import dump_scenario
 
 TARGET_MIXED_SUCCESS = 0.98  # the paper planner on the mixed set, with 0 collisions
-
-
-@dataclass(frozen=True)
-class Job:
-    planner: str
-    world: Path
-    out: Path
-
-    @property
-    def name(self) -> str:
-        return self.world.stem
 
 
 def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path) -> list[Path]:
@@ -50,40 +40,6 @@ def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path
             path = directory / f"{family}-{s}.yaml"
             paths.append(dump_scenario(random_scenario(family, s), path))
     return paths
-
-
-def run_job(job: Job, timeout: float) -> dict[str, Any]:
-    """One ``zenav run``; the run record, or an ``error`` record if the run failed."""
-    record_path = job.out / "run.json"
-    if record_path.exists():
-        record: dict[str, Any] = json.loads(record_path.read_text())
-        return record
-    try:
-        done = subprocess.run(
-            [sys.executable, "-m", "zenav", "run", str(job.world), "--out", str(job.out),
-             "--planner", job.planner, "--log-level", "WARNING"],
-            capture_output=True, text=True, check=False, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return {"scenario": job.name, "planner": job.planner, "outcome": "error",
-                "error": f"no result within {timeout:.0f} s"}
-    if done.returncode != 0 or not record_path.exists():
-        return {"scenario": job.name, "planner": job.planner, "outcome": "error",
-                "error": (done.stderr.strip().splitlines() or ["?"])[-1]}
-    record = json.loads(record_path.read_text())
-    return record
-
-
-def run_all(jobs: list[Job], parallel: int, timeout: float,
-            on_done: Callable[[Job, dict[str, Any]], None]) -> list[tuple[Job, dict[str, Any]]]:
-    results: list[tuple[Job, dict[str, Any]]] = []
-    with ThreadPoolExecutor(max_workers=parallel) as pool:
-        futures = {pool.submit(run_job, job, timeout): job for job in jobs}
-        for future in as_completed(futures):
-            job = futures[future]
-            record = future.result()
-            results.append((job, record))
-            on_done(job, record)
-    return results
 
 
 @dataclass
@@ -211,46 +167,21 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
 
 def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
          path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """nav.png: outcomes per planner, success per world family."""
+    from zenav.plot import draw_bench_chart
 
     planners = [s.planner for s in summaries]
-    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.5))
-    bottom = [0.0] * len(planners)
-    for label, colour, values in (
-        ("reached", "#3a923a", [s.rate(s.reached) for s in summaries]),
-        ("timeout", "#e0a030", [s.rate(s.timeouts) for s in summaries]),
-        ("collision", "#c83737", [s.rate(s.collisions) for s in summaries]),
-    ):
-        shown = [0.0 if math.isnan(v) else 100 * v for v in values]
-        left.bar(planners, shown, bottom=bottom, color=colour, label=label)
-        bottom = [b + v for b, v in zip(bottom, shown, strict=True)]
-    left.set_ylabel("runs, %")
-    left.set_title("outcome per planner, all worlds")
-    left.legend(loc="lower right")
-    names = [f for f in FAMILIES if f in families]
-    width = 0.8 / max(len(planners), 1)
-    for i, p in enumerate(planners):
-        rates = []
-        for f in names:
-            n = families[f].get(p + "/n", 0)
-            rates.append(100 * families[f].get(p + "/ok", 0) / n if n else 0.0)
-        right.bar([k + i * width for k in range(len(names))], rates, width=width, label=p)
-    right.set_xticks([k + width * (len(planners) - 1) / 2 for k in range(len(names))])
-    right.set_xticklabels(names)
-    right.set_ylabel("success, %")
-    right.set_ylim(0, 105)
-    right.set_title("success per world family")
-    right.legend(loc="lower right", fontsize="small")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    outcomes = {"reached": [s.rate(s.reached) for s in summaries],
+                "timeout": [s.rate(s.timeouts) for s in summaries],
+                "collision": [s.rate(s.collisions) for s in summaries]}
+    success = {f: [100 * families[f].get(p + "/ok", 0) / families[f][p + "/n"]
+                   if families[f].get(p + "/n", 0) else 0.0 for p in planners]
+               for f in FAMILIES if f in families}
+    draw_bench_chart(planners, outcomes, success, path)
 
 
 def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
-            families: Sequence[str] = FAMILIES, jobs: int = 2, timeout: float = 1800.0,
+            families: Sequence[str] = FAMILIES, jobs: int = 2,
             progress: bool = True, echo: Callable[[str], None] = print) -> str:
     """Write the worlds, run every planner on each, print and write the report."""
     from rich.progress import (
@@ -273,7 +204,8 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
         raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(FAMILIES)}")
     out.mkdir(parents=True, exist_ok=True)
     paths = write_worlds(families, worlds, seed, out / "worlds")
-    job_list = [Job(p, w, out / "runs" / p / w.stem) for w in paths for p in planners]
+    job_list = [Job(f"{p}/{w.stem}", w, out / "runs" / p / w.stem, planner=p)
+                for w in paths for p in planners]
     records: list[dict[str, Any]] = []
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TimeElapsedColumn(), TimeRemainingColumn(), disable=not progress,
@@ -285,7 +217,7 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             bar.update(task, advance=1, description=f"{job.planner} {job.name}: "
                        f"{record['outcome']}")
 
-        run_all(job_list, jobs, timeout, done)
+        run_batch(job_list, jobs, done, log_level="WARNING", reuse=True, keep_going=True)
     for r in records:
         if r["outcome"] == "error":
             echo(f"run failed: {r['planner']} {r['scenario']}: {r.get('error')}")
@@ -305,3 +237,32 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     echo(report)
     echo(f"wrote {out / 'nav.md'}, {out / 'nav.png'}, {out / 'nav.json'}")
     return report
+
+
+def _command(args: argparse.Namespace) -> int:
+    try:
+        run_nav(words(args.planners), args.worlds, args.seed, args.out,
+                families=words(args.families), jobs=args.jobs,
+                progress=not args.no_progress)
+    except ValueError as exc:
+        print(f"zenav bench nav: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def add_command(kinds: Any) -> None:
+    """``zenav bench nav`` (``kinds``: the subcommands of ``zenav bench``)."""
+    nav = kinds.add_parser("nav", help="planners on seeded random worlds through zenav run")
+    nav.add_argument("--planners", default="paper,vfh,dwa,apf",
+                     help="comma-separated planner names (default paper,vfh,dwa,apf)")
+    nav.add_argument("--worlds", type=int, default=5, help="worlds per family (default 5)")
+    nav.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
+    nav.add_argument("--families", default=",".join(FAMILIES),
+                     help=f"comma-separated world families (default {','.join(FAMILIES)})")
+    nav.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                     help="runs at a time (default: the number of cores; each run is six "
+                     "processes)")
+    nav.add_argument("--out", type=Path, default=Path("out/bench-nav"),
+                     help="directory for the worlds, runs, nav.md, nav.png, nav.json")
+    nav.add_argument("--no-progress", action="store_true", help="no progress bar")
+    nav.set_defaults(func=_command)

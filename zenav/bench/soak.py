@@ -31,16 +31,16 @@ import time
 from pathlib import Path
 from typing import Any
 
-import psutil
 import yaml
 
+from zenav.bench.common import rss_mb
 from zenav.launch import Stack
-from zenav.monitor import MonitorModel
-from zenav.run import stack_params
+from zenav.monitor.model import MonitorModel
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import ServiceStatus
+from zenav.services.mission import stack_params
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import load_scenario
 
@@ -77,14 +77,6 @@ def percentiles(samples: list[float]) -> dict[str, float | int | None]:
 
     return {"n": len(ordered), "p50": statistics.median(ordered), "p90": at(0.90),
             "p99": at(0.99), "max": ordered[-1]}
-
-
-def rss_mb(pids: dict[str, int]) -> dict[str, float]:
-    out = {}
-    for name, pid in pids.items():
-        with contextlib.suppress(psutil.Error):
-            out[name] = psutil.Process(pid).memory_info().rss / 2**20
-    return out
 
 
 def counters(statuses: dict[str, ServiceStatus]) -> dict[str, dict[str, Any]]:

@@ -18,7 +18,8 @@ Measured, per (robot motion, range noise, method):
 Targets (issue): >= 95 % correct type; speed within 10 % and heading within 5 degrees for a
 mover seen for 1 s, at noise 0.01 m. Seeded: the same command prints the same table.
 
-Run: ``python bench/tracking_accuracy.py [--seeds N] [--duration S]``.
+Run: ``zenav bench accuracy [--seeds N] [--duration S]`` (or ``python -m
+zenav.bench.tracking_accuracy ...``).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import argparse
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -351,13 +353,14 @@ def format_table(rows: Sequence[Row]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Print the accuracy table (and one per mover speed at noise 0.01 m)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=int, default=3, help="runs per mover and setting")
     parser.add_argument("--no-per-mover", action="store_true", help="skip the per-mover tables")
     parser.add_argument("--duration", type=float, default=6.0, help="seconds per run")
-    args = parser.parse_args(argv)
+
+
+def report(args: argparse.Namespace) -> int:
+    """Print the accuracy table (and one per mover speed at noise 0.01 m)."""
     print("Typing accuracy after each obstacle's first two frames; mover speed (relative) and")
     print("heading errors (degrees) once seen for 1 s: median, 95th percentile, share within")
     print(f"target. Movers (m/s): {', '.join(f'{s:g}' for s, _ in PAPER_MOVERS)}; "
@@ -373,6 +376,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"\n{speed:g} m/s, alpha_o {alpha:g} deg")
         print(format_table(rows))
     return 0
+
+
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m zenav.bench.tracking_accuracy [--seeds N] [--duration S]``."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    _add_arguments(parser)
+    return report(parser.parse_args(argv))
+
+
+def add_command(kinds: Any) -> None:
+    """``zenav bench accuracy`` (``kinds``: the subcommands of ``zenav bench``)."""
+    accuracy = kinds.add_parser("accuracy", help="obstacle typing, mover speed and heading "
+                                "errors on simulated scans (paper vs smoothed estimate)")
+    _add_arguments(accuracy)
+    accuracy.set_defaults(func=report)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,112 @@
+"""A real-time stack with the bench listening to it, for the latency, memory and rate
+benchmarks of ``zenav bench perf``."""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from zenav.launch import Stack
+from zenav.schemas import keys
+from zenav.schemas.codec import DecodeError, decode
+from zenav.schemas.keys import Keys, Topic
+from zenav.schemas.messages import BaseCommand, ServiceStatus
+from zenav.services.mission import stack_params
+from zenav.sim.scenario import load_scenario
+from zenav.tooling import SampleCallback, StampedSubscriber, ThreadedBus
+
+
+class Listener:
+    """The bench's own tool on the stack's bus: the wall receive time (taken in Zenoh's
+    callback) of every scan, velocity command and base command by stamp, and the latest
+    status per service. Its liveliness token ``bench`` is up once it listens."""
+
+    def __init__(self, stack: Stack) -> None:
+        self.k = Keys(stack.robot_id)
+        self.lock = threading.Lock()
+        self.scans: dict[float, float] = {}
+        self.commands: dict[float, float] = {}
+        self.base: dict[float, float] = {}
+        self.status: dict[str, ServiceStatus] = {}
+        self._bus = ThreadedBus(stack.transport(driver=True))
+        self._subscribers = self._bus.call(self._listen)
+
+    def _listen(self) -> list[StampedSubscriber]:
+        bus = self._bus.bus
+        subscribers = [StampedSubscriber(bus, self.k.of(topic), self._stamped(topic, into))
+                       for topic, into in ((keys.SCAN, self.scans), (keys.CMD_VEL, self.commands),
+                                           (keys.BASE_CMD, self.base))]
+        subscribers.append(StampedSubscriber(bus, self.k.status_any, self._status))
+        bus.declare_token(self.k.alive("bench"))
+        return subscribers
+
+    def _stamped(self, topic: Topic, into: dict[float, float]) -> SampleCallback:
+        def on_sample(key: str, payload: bytes, received_ns: int) -> None:
+            with contextlib.suppress(DecodeError):
+                message = decode(payload, topic.message, key, topic.max_bytes)
+                if isinstance(message, BaseCommand) and message.reason != "command":
+                    return
+                with self.lock:
+                    into.setdefault(float(message.stamp), received_ns / 1e9)
+
+        return on_sample
+
+    def _status(self, key: str, payload: bytes, received_ns: int) -> None:
+        with contextlib.suppress(DecodeError):
+            status = decode(payload, ServiceStatus, key, keys.STATUS.max_bytes)
+            with self.lock:
+                self.status[status.service] = status
+
+    def drops(self) -> dict[str, int]:
+        with self.lock:
+            return {s: int(sum(d.dropped.values())) for s, d in self.status.items()}
+
+    def close(self) -> None:
+        def unsubscribe() -> None:
+            for subscriber in self._subscribers:
+                subscriber.close()
+
+        with contextlib.suppress(Exception):
+            self._bus.call(unsubscribe)
+        self._bus.close()
+
+
+@contextlib.contextmanager
+def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str, Any]]
+               ) -> Iterator[tuple[Stack, Listener]]:
+    """A real-time stack on ``scenario_path`` with the bench listening; the simulator's
+    clock starts once the bench's liveliness token is up."""
+    scenario = load_scenario(scenario_path)
+    params = stack_params(scenario, scenario_path, "paper")
+    params["simulator"].update(clock="realtime",
+                               wait_for=["laser_driver", "perception", "tracking", "planner",
+                                         "motor_bridge", "bench"])
+    params["motor_bridge"]["clock"] = "realtime"
+    for service, values in overrides.items():
+        params.setdefault(service, {}).update(values)
+    stack = Stack(out_dir=out_dir, params=params, log_level="WARNING")
+    stack.start()
+    listener: Listener | None = None
+    try:
+        listener = Listener(stack)
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            failure = stack.failure()
+            if failure:
+                raise RuntimeError(failure)
+            with listener.lock:
+                if listener.scans:
+                    break
+            time.sleep(0.05)
+        else:
+            raise RuntimeError(f"no scan within 60 s; see {out_dir / 'logs'}")
+        yield stack, listener
+    finally:
+        if listener is not None:
+            listener.close()
+        stack.stop()
+

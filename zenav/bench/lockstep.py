@@ -1,0 +1,83 @@
+"""``zenav bench perf``, lockstep: ``zenav run`` on the eight paper scenarios, simulated
+seconds per wall second of the simulator's loop (from its log) and of the whole run."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import subprocess
+import sys
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+from zenav.bench.common import fmt, verdict
+from zenav.sim import SCENARIO_DIR
+
+PAPER_SCENARIOS = tuple(sorted(SCENARIO_DIR.glob("[a-h]-*.yaml")))
+TARGET_LOCKSTEP_FACTOR = 50.0
+
+_LOG_TIME = re.compile(r"^(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d,\d{3}) ")
+
+
+def _log_seconds(log: Path) -> float | None:
+    """Wall seconds between the simulator's 'run ... starts' and 'run ... ended' lines."""
+    start = end = None
+    for line in log.read_text(errors="replace").splitlines():
+        match = _LOG_TIME.match(line)
+        if match is None:
+            continue
+        when = datetime.strptime(match.group(1), "%Y-%m-%d %H:%M:%S,%f").timestamp()
+        if " starts (" in line:
+            start = when
+        elif " ended: " in line:
+            end = when
+    return None if start is None or end is None else end - start
+
+
+@dataclass
+class LockstepRow:
+    scenario: str
+    outcome: str
+    sim_time: float
+    loop_wall: float | None
+    command_wall: float
+
+
+def measure_lockstep(work: Path, scenarios: tuple[Path, ...] = PAPER_SCENARIOS,
+                     planner: str = "paper") -> list[LockstepRow]:
+    rows = []
+    for path in scenarios:
+        out = work / "lockstep" / path.stem
+        done = subprocess.run(
+            [sys.executable, "-m", "zenav", "run", str(path), "--out", str(out),
+             "--planner", planner], capture_output=True, text=True, check=False, timeout=1800)
+        if done.returncode != 0:
+            raise RuntimeError(f"zenav run {path.name} failed: {done.stderr.strip()}")
+        record = json.loads((out / "run.json").read_text())
+        rows.append(LockstepRow(path.stem, record["outcome"], record["time"],
+                                _log_seconds(out / "logs" / "simulator.log"),
+                                record["wall_time"]))
+    return rows
+
+
+def lockstep_table(rows: list[LockstepRow]) -> str:
+    lines = ["| scenario | outcome | simulated s | simulator loop wall s | × real time (loop) | "
+             "zenav run wall s | × real time (whole command) |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        loop = r.loop_wall if r.loop_wall else math.nan
+        lines.append(f"| {r.scenario} | {r.outcome} | {r.sim_time:.1f} | {fmt(loop, 1)} | "
+                     f"{fmt(r.sim_time / loop, 1)} | {r.command_wall:.1f} | "
+                     f"{r.sim_time / r.command_wall:.1f} |")
+    sim = sum(r.sim_time for r in rows)
+    loop_total = sum(r.loop_wall or math.nan for r in rows)
+    wall = sum(r.command_wall for r in rows)
+    factor = sim / loop_total
+    lines.append(f"| **all** | | {sim:.1f} | {fmt(loop_total, 1)} | **{fmt(factor, 1)}** | "
+                 f"{wall:.1f} | {sim / wall:.1f} |")
+    lines.append("")
+    lines.append(f"Target: ≥ {TARGET_LOCKSTEP_FACTOR:g}× real time — measured {fmt(factor, 1)}× "
+                 f"in the simulator's loop, {sim / wall:.1f}× for the whole command with the "
+                 f"processes' start and stop ({verdict(factor >= TARGET_LOCKSTEP_FACTOR)}).")
+    return "\n".join(lines)
