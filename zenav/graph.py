@@ -128,3 +128,9 @@ def derive_graph() -> dict[str, Any]:
 def main(args: argparse.Namespace) -> int:
     print(yaml.safe_dump(derive_graph(), sort_keys=False, default_flow_style=None), end="")
     return 0
+
+
+def add_command(sub: Any) -> None:
+    graph = sub.add_parser("graph", help="print each service's input and output keys with "
+                           "their message types (as in deploy/graph.yaml)")
+    graph.set_defaults(func=main)

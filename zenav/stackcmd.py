@@ -1,0 +1,76 @@
+"""The commands that run or describe the stack itself: ``zenav run`` (one scenario
+through the six processes), ``zenav service`` (one service process) and ``zenav schemas``
+(the JSON Schema of every message)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from zenav.services.config import SERVICE_ORDER
+
+
+def _run(args: argparse.Namespace) -> int:
+    from zenav.run import RunError, run_scenario
+    from zenav.services.config import ConfigError
+    from zenav.sim.scenario import ScenarioError
+
+    try:
+        record = run_scenario(args.scenario, args.out, planner=args.planner,
+                              overrides=args.set, log_level=args.log_level)
+    except (ScenarioError, ConfigError) as exc:
+        # one line, every problem in it: "file: field: problem; file: field: problem"
+        print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
+        return 2
+    except RunError as exc:
+        print(f"zenav run: {exc}", file=sys.stderr)
+        return 1
+    clearance = record["min_clearance"]
+    print(f"{record['scenario']}: {record['outcome']} at t={record['time']:.2f} s, "
+          f"path {record['path_length']:.2f} m, min clearance "
+          f"{'-' if clearance is None else f'{clearance:.3f} m'}, "
+          f"{len(record['events'])} events, {record['wall_time']:.1f} s wall -> {args.out}")
+    return 0
+
+
+def _service(args: argparse.Namespace) -> int:
+    from zenav.services.runner import main as service_main
+
+    return service_main(args.name, args.rest)
+
+
+def _schemas(args: argparse.Namespace) -> int:
+    from zenav.schemas.messages import ALL_MESSAGES
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    for message in ALL_MESSAGES:
+        schema = message.model_json_schema(mode="serialization")
+        path = args.out / f"{message.TYPE}.schema.json"
+        path.write_text(json.dumps(schema, indent=2) + "\n")
+        print(path)
+    return 0
+
+
+def add_commands(sub: Any) -> None:
+    run = sub.add_parser("run", help="run a scenario through the whole stack")
+    run.add_argument("scenario", type=Path, help="scenario YAML file")
+    run.add_argument("--out", type=Path, required=True, help="directory for run.json, run.png")
+    run.add_argument("--planner", default="paper", help="planner service (default paper)")
+    run.add_argument("--set", action="append", default=[], metavar="SERVICE.NAME=VALUE",
+                     help="override a service parameter, e.g. perception.lambda_=1.5")
+    run.add_argument("--log-level", default="INFO", help="services' log level")
+    run.set_defaults(func=_run)
+
+    service = sub.add_parser("service", help="run one service process",
+                             description="Run one service; options after NAME go to it "
+                                         "(zenav service NAME --help).")
+    service.add_argument("name", choices=SERVICE_ORDER)
+    # the arguments zenav.cli.main does not know go to the service (args.rest)
+    service.set_defaults(func=_service, passes_rest=True)
+
+    schemas = sub.add_parser("schemas", help="write the JSON Schema of every message")
+    schemas.add_argument("--out", type=Path, default=Path("schemas/json"))
+    schemas.set_defaults(func=_schemas)
