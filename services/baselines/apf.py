@@ -34,8 +34,11 @@ from zenav.services.baselines.common import (
     returns,
     world_points,
 )
-from zenav.services.baselines.params import APFParams as Params
+from zenav.services.baselines.params import APFParams
 from zenav.services.geometry import wrap_angle
+
+Params = APFParams
+"""The parameters (also read as ``apf.Params`` by zenav/bench/compute.py)."""
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,11 @@ from zenav.services.baselines.common import (
     returns,
     world_points,
 )
-from zenav.services.baselines.params import DWAParams as Params
+from zenav.services.baselines.params import DWAParams
 from zenav.services.geometry import wrap_angles
+
+Params = DWAParams
+"""The parameters (also read as ``dwa.Params`` by zenav/bench/compute.py)."""
 
 
 @dataclass(frozen=True)

@@ -42,8 +42,11 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.services.baselines.common import Cycle, FloatArray, returns
-from zenav.services.baselines.params import VFHParams as Params
+from zenav.services.baselines.params import VFHParams
 from zenav.services.geometry import wrap_angle, wrap_positive
+
+Params = VFHParams
+"""The parameters (also read as ``vfh.Params`` by zenav/bench/compute.py)."""
 
 IntArray = npt.NDArray[np.int64]
 
