@@ -33,6 +33,15 @@ def _resolve(args: argparse.Namespace) -> tuple[Deployment | None, Path]:
     return deployment, run_dir.resolve()
 
 
+def _resolve_or_say(args: argparse.Namespace) -> tuple[Deployment | None, Path] | None:
+    """:func:`_resolve`, or None after printing why not (the command then exits with 2)."""
+    try:
+        return _resolve(args)
+    except ConfigError as exc:
+        print(f"zenav {args.command}: {exc}", file=sys.stderr)
+        return None
+
+
 def cmd_up(args: argparse.Namespace) -> int:
     try:
         deployment, run_dir = _resolve(args)
@@ -79,11 +88,9 @@ def cmd_up(args: argparse.Namespace) -> int:
 
 
 def cmd_down(args: argparse.Namespace) -> int:
-    try:
-        deployment, run_dir = _resolve(args)
-    except ConfigError as exc:
-        print(f"zenav down: {exc}", file=sys.stderr)
+    if (resolved := _resolve_or_say(args)) is None:
         return 2
+    deployment, run_dir = resolved
     name = deployment.name if deployment else run_dir.name
     sup = Supervisor(run_dir)
     pid = sup.pid()
@@ -115,12 +122,9 @@ def cmd_down(args: argparse.Namespace) -> int:
 
 
 def cmd_ctl(args: argparse.Namespace) -> int:
-    try:
-        _, run_dir = _resolve(args)
-    except ConfigError as exc:
-        print(f"zenav ctl: {exc}", file=sys.stderr)
+    if (resolved := _resolve_or_say(args)) is None:
         return 2
-    return Supervisor(run_dir).ctl(list(args.args) or ["status"])
+    return Supervisor(resolved[1]).ctl(list(args.args) or ["status"])
 
 
 def _add_common(parser: argparse.ArgumentParser) -> None:
