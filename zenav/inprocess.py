@@ -21,11 +21,11 @@ from typing_extensions import override
 
 from zenav.run import apply_override
 from zenav.schemas.messages import LaserScan, Pose2D, RawLaserFrame, Track, TrackList
-from zenav.services.laser_driver.node import Params as DriverParams
-from zenav.services.laser_driver.node import frame_to_scan
+from zenav.services.laser_driver.params import Params as DriverParams
+from zenav.services.laser_driver.scan import frame_to_scan
 from zenav.services.mission import stack_params
-from zenav.services.motor_bridge.node import CommandFilter
-from zenav.services.motor_bridge.node import Params as BridgeParams
+from zenav.services.motor_bridge.command_filter import CommandFilter
+from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
@@ -36,9 +36,9 @@ from zenav.services.planner.prediction import Assessment, Obstacle
 from zenav.services.tracking.node import track_message
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Tracker
-from zenav.sim.node import Params as SimParams
-from zenav.sim.node import Simulation
+from zenav.sim.params import Params as SimParams
 from zenav.sim.scenario import load_scenario
+from zenav.sim.simulation import Simulation
 
 StageTimes = dict[str, list[float]]
 Pose = tuple[float, float, float]

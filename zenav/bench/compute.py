@@ -90,8 +90,9 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10,
     from zenav.services.baselines import apf, dwa, vfh
     from zenav.services.baselines.common import Cycle
     from zenav.services.baselines.node import movers_of
-    from zenav.sim.node import Params as SimParams
-    from zenav.sim.node import Simulation
+    from zenav.services.baselines.params import APFParams, DWAParams, VFHParams
+    from zenav.sim.params import Params as SimParams
+    from zenav.sim.simulation import Simulation
 
     scenario = perf_scenario(count, seed)
     params = stack_params(scenario, Path("perf.yaml"), "paper")
@@ -103,9 +104,9 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10,
     shadow_clock = StageClock()
     shadow = TimedPlanner(pipeline.planner_params, shadow_clock)
     baselines: dict[str, vfh.VFH | dwa.DWA | apf.APF] = {
-        "vfh": vfh.VFH(vfh.Params.model_validate(params["planner"])),
-        "dwa": dwa.DWA(dwa.Params.model_validate(params["planner"])),
-        "apf": apf.APF(apf.Params.model_validate(params["planner"])),
+        "vfh": vfh.VFH(VFHParams.model_validate(params["planner"])),
+        "dwa": dwa.DWA(DWAParams.model_validate(params["planner"])),
+        "apf": apf.APF(APFParams.model_validate(params["planner"])),
     }
     result = ComputeResult(count, 0, 0.0, 0.0, 0,
                            {k: [] for k in (*STAGES, "morphin_call", *BASELINES)})

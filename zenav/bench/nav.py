@@ -193,12 +193,12 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
         TimeRemainingColumn,
     )
 
-    from zenav.services.runner import PLANNER_MODULES
+    from zenav.services.runner import PLANNERS
 
-    unknown = [p for p in planners if p not in PLANNER_MODULES]
+    unknown = [p for p in planners if p not in PLANNERS]
     if unknown:
         raise ValueError(f"unknown planner {', '.join(unknown)}; choose from "
-                         f"{', '.join(PLANNER_MODULES)}")
+                         f"{', '.join(PLANNERS)}")
     bad = [f for f in families if f not in FAMILIES]
     if bad:
         raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(FAMILIES)}")
