@@ -56,9 +56,6 @@ PLANNERS: dict[str, Where] = {
 """Planner implementations: each reads the same inputs and publishes the same outputs
 as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""
 
-PLANNER_MODULES = PLANNERS
-"""The old name of :data:`PLANNERS` (zenav/bench_nav.py reads it)."""
-
 SERVICES: dict[str, Where] = {
     "simulator": Where("zenav.sim.params:Params", "zenav.sim.node:Service"),
     "laser_driver": Where("zenav.services.laser_driver.params:Params",
@@ -108,9 +105,6 @@ def implementation(name: str, planner: str = "paper") -> Implementation:
     where = _where(name, planner)
     return Implementation(_load(where.params), _load(where.service))
 
-
-service_module = implementation
-"""The old name of :func:`implementation` (zenav/graph.py calls it)."""
 
 
 def add_transport_arguments(parser: argparse.ArgumentParser) -> None:

@@ -80,10 +80,10 @@ def _relative(key_expr: str, k: Keys) -> str:
 
 def probe_service(name: str, planner: str = "paper") -> tuple[dict[str, Any], set[type[Message]]]:
     """One service's graph entry, and the message types it uses, from its code."""
-    from zenav.services.runner import service_module
+    from zenav.services.runner import implementation
 
     k = Keys(PROBE_ROBOT)
-    module = service_module(name, planner)
+    module = implementation(name, planner)
     params = module.Params(scenario=SCENARIO) if name == "simulator" else module.Params()
     bus = _ProbeBus()
     node = _ProbeNode(name, bus, k)

@@ -27,10 +27,6 @@ from zenav.services.runner import PLANNERS
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import load_scenario
 
-__all__ = ["RunError", "apply_override", "make_record", "run_scenario", "stack_params"]
-# stack_params lives in zenav.services.mission; zenav/inprocess.py, soak.py, deploy and
-# bench still import it from here.
-
 
 class RunError(RuntimeError):
     """The run could not be made; the message is the one-line reason."""
