@@ -20,6 +20,7 @@ import numpy as np
 import yaml
 
 from zenav.batch import Job, run_batch
+from zenav.services.mission import window_radius
 from zenav.sim import SCENARIO_DIR
 from zenav.sim.scenario import Scenario, load_scenario
 
@@ -198,7 +199,7 @@ def make_figures(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]])
         if job.key not in (*SIMULATIONS, ROBUSTNESS):
             continue
         scenario = load_scenario(job.scenario)
-        window = min(8 * scenario.world.cell, scenario.laser.max_range)
+        window = window_radius(scenario.world.cell, scenario.laser.max_range)
         record = records[job.key]
         draw_experiment(scenario, record, figures / f"{job.key}.png", window, job.key)
         draw_animation(scenario, record, figures / f"{job.key}.gif", window)

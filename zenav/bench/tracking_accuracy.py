@@ -34,6 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import LaserScan
+from zenav.services.geometry import wrap_angle
 from zenav.services.perception.clustering import cluster_scan
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
@@ -206,7 +207,7 @@ def run_case(scenario: Scenario, method: Method, moving: bool, duration: float) 
             if kind == "dynamic" and track is not None and t - first_seen[oid] >= SEEN_FOR - 1e-9:
                 tally.speed_err.append(abs(track.speed - speed_true) / speed_true)
                 err = math.atan2(vel[1], vel[0]) - track.heading
-                tally.heading_err.append(abs(math.degrees(math.remainder(err, math.tau))))
+                tally.heading_err.append(abs(math.degrees(wrap_angle(err))))
     return tally
 
 
