@@ -4,10 +4,21 @@ kill -9, ...), printed in a section of pytest's summary so that they can be quot
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 
 MEASURED: list[str] = []
+
+HERE = Path(__file__).resolve().parent
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Everything in this folder is of the process tier, marked or not: a module that
+    forgets ``pytestmark`` must not slip into the fast tier (``-m "not integration"``)."""
+    for item in items:
+        if HERE in Path(str(item.fspath)).resolve().parents:
+            item.add_marker(pytest.mark.integration)
 
 
 @pytest.fixture
