@@ -16,7 +16,7 @@ import logging
 import time
 from collections import Counter
 from collections.abc import Awaitable, Callable, Coroutine
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, Protocol, TypeVar
 
 from zenav.schemas.codec import DecodeError, decode, encode
 from zenav.schemas.keys import Keys, Topic
@@ -276,6 +276,10 @@ class Node:
             self._status.publish(self.status(stamp=time.time()))
 
 
+class Republisher(Protocol):
+    def republish(self) -> None: ...
+
+
 class StampGate:
     """Orders one input stream by stamp.
 
@@ -290,7 +294,7 @@ class StampGate:
         self.node = node
         self.topic = topic
 
-    def admit(self, stamp: float, output: TypedPublisher[Any]) -> bool:
+    def admit(self, stamp: float, output: Republisher) -> bool:
         """True for a new stamp; a repeat is answered with ``output``'s last message, an
         earlier stamp is refused and counted (``out_of_order``)."""
         order = self.check(stamp)

@@ -16,6 +16,7 @@ import asyncio
 import contextlib
 import json
 import logging
+import uuid
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
@@ -115,7 +116,9 @@ class Subscription:
 
 class Publisher(ABC):
     @abstractmethod
-    def put(self, payload: bytes) -> None: ...
+    def put(self, payload: bytes, attachment: bytes | None = None) -> None:
+        """Send ``payload``; ``attachment`` is Zenoh's per-sample metadata (ROS 2 over
+        rmw_zenoh carries a sequence number, a source time and a GID there)."""
 
 
 class Token(ABC):
@@ -125,6 +128,14 @@ class Token(ABC):
 
 class Bus(ABC):
     """What a service needs from the middleware."""
+
+    _session_id: str | None = None
+
+    def session_id(self) -> str:
+        """This participant's id in lowercase hex (Zenoh's session id on Zenoh)."""
+        if self._session_id is None:
+            self._session_id = uuid.uuid4().hex
+        return self._session_id
 
     @abstractmethod
     def publisher(self, key: str, *, reliable: bool = False, urgent: bool = False) -> Publisher:
@@ -168,8 +179,8 @@ class _MemoryPublisher(Publisher):
         self._bus = bus
         self._key = key
 
-    def put(self, payload: bytes) -> None:
-        self._bus.deliver(self._key, bytes(payload))
+    def put(self, payload: bytes, attachment: bytes | None = None) -> None:
+        self._bus.deliver(self._key, bytes(payload), attachment)
 
 
 class _MemoryToken(Token):
@@ -194,8 +205,12 @@ class InMemoryBus(Bus):
         self._watchers: list[tuple[str, LivelinessCallback]] = []
         self._queryables: list[tuple[str, Snapshot]] = []
         self.published: list[tuple[str, bytes]] = []
+        self.attachments: dict[int, bytes] = {}
+        """Attachments sent, by index into ``published``."""
 
-    def deliver(self, key: str, payload: bytes) -> None:
+    def deliver(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
+        if attachment is not None:
+            self.attachments[len(self.published)] = attachment
         self.published.append((key, payload))
         for sub in list(self._subs):
             if key_matches(sub.key_expr, key):
@@ -248,8 +263,8 @@ class _ZenohPublisher(Publisher):
     def __init__(self, publisher: Any) -> None:
         self._publisher = publisher
 
-    def put(self, payload: bytes) -> None:
-        self._publisher.put(payload)
+    def put(self, payload: bytes, attachment: bytes | None = None) -> None:
+        self._publisher.put(payload, attachment=attachment)
 
 
 class _ZenohToken(Token):
@@ -271,6 +286,9 @@ class ZenohBus(Bus):
     @property
     def session(self) -> Any:
         return self._session
+
+    def session_id(self) -> str:
+        return str(self._session.zid())
 
     def _to_loop(self, callback: Callable[..., None], *args: object) -> None:
         """Runs on a Zenoh thread: schedule ``callback`` on the loop and return at once."""

@@ -13,6 +13,9 @@ Two clocks:
   again (the services answer a repeated stamp by repeating their output), so a message
   lost while the stack connects costs a little time, not the run.
 - ``realtime``: ticks follow the wall clock; the latest base command is in force.
+
+With ``robot: ros2`` the simulated robot shows a ROS 2 face instead of zenav's device
+keys (:mod:`zenav.sim.ros2_face`): LaserScan and Odometry out, velocity commands in.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, GroundTruth, Odometry, RawLaserFrame, RunResult
 from zenav.services.node import Node
 from zenav.sim.params import Params
+from zenav.sim.ros2_face import Ros2Face
 from zenav.sim.scenario import load_scenario
 from zenav.sim.simulation import Simulation
 
@@ -54,7 +58,12 @@ class Service:
         self._answered = asyncio.Event()
         self._alive: set[str] = set()
         self._alive_changed = asyncio.Event()
-        node.subscribe(keys.BASE_CMD, BaseCommand, self.on_base_command, depth=4)
+        self.face: Ros2Face | None = None
+        if params.robot == "ros2":
+            self.face = Ros2Face(node, params.ros2, self.sim.scenario.laser,
+                                 self.on_base_command, lambda: self.sim.t)
+        else:
+            node.subscribe(keys.BASE_CMD, BaseCommand, self.on_base_command, depth=4)
         node.bus.watch_liveliness(node.keys.alive_any, self.on_liveliness)
 
     def on_base_command(self, command: BaseCommand) -> None:
@@ -90,10 +99,19 @@ class Service:
                 continue
         log.info("all services alive: %s", ", ".join(sorted(self._alive)))
 
+    def close(self) -> None:
+        if self.face is not None:
+            self.face.close()
+
     def publish_tick(self, with_scan: bool) -> None:
-        seq = self.odom.next_seq()
-        self.odom.publish(self.sim.odometry(seq))
+        odometry = self.sim.odometry(self.odom.next_seq())
         self.truth.publish(self.sim.truth(self.truth.next_seq()))
+        if self.face is not None:
+            self.face.publish_odometry(odometry)
+            if with_scan:
+                self.face.publish_scan(self.sim.t, self.sim.scan())
+            return
+        self.odom.publish(odometry)
         if with_scan:
             ranges = self.sim.scan()
             self.raw.publish(RawLaserFrame(stamp=self.sim.t, seq=self.raw.next_seq(),
@@ -113,8 +131,11 @@ class Service:
                         f"{self.params.answer_timeout:.0f} s"
                     ) from None
                 log.debug("no answer for t=%.2f yet; resending", self.sim.t)
-                self.odom.republish()
-                self.raw.republish()
+                if self.face is not None:
+                    self.face.republish()
+                else:
+                    self.odom.republish()
+                    self.raw.republish()
 
     async def run(self) -> None:
         await self.wait_for_stack()

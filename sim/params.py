@@ -1,13 +1,15 @@
-"""Simulator parameters: the scenario, the clock, the simulated base's limits."""
+"""Simulator parameters: the scenario, the clock, the simulated base's limits, and the
+face it shows the stack (zenav's device keys or a ROS 2 robot)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from zenav.services.mission import LIVE_SERVICES, MAX_OMEGA
+from zenav.services.ros2.params import Ros2Params
 
 
 class Params(BaseModel):
@@ -41,3 +43,17 @@ class Params(BaseModel):
         1.0, gt=0, description="realtime: the simulated base holds its last command at most "
         "this many wall s, then stops (a base's own watchdog, for when the bridge is gone)"
     )
+    robot: Literal["native", "ros2"] = Field(
+        "native", description="native: zenav's device/* keys and odom; ros2: a ROS 2 robot "
+        "over rmw_zenoh (/scan, /odom, /cmd_vel)")
+    ros2: Ros2Params = Field(
+        default_factory=lambda: Ros2Params(node_name="zenav_sim_robot"),
+        description="topics, frames and domain of the simulated ROS 2 robot")
+
+    @model_validator(mode="after")
+    def _stamped_for_lockstep(self) -> Params:
+        if self.robot == "ros2" and self.clock == "lockstep" and not self.ros2.twist_stamped:
+            raise ValueError("a lockstep ROS 2 robot needs ros2.twist_stamped=true (a plain "
+                             "Twist has no stamp to say which scan it answers); or use "
+                             "clock=realtime")
+        return self

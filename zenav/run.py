@@ -23,6 +23,7 @@ from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
 from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
 from zenav.services.mission import stack_params
+from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
 from zenav.services.runner import PLANNERS
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import load_scenario
@@ -159,12 +160,20 @@ def run_scenario(
     progress_timeout: float = 90.0,
     log_level: str = "INFO",
     picture: bool = True,
+    robot_face: str = "native",
 ) -> dict[str, Any]:
-    """Run one scenario through the full stack; write run.json and run.png; the record."""
+    """Run one scenario through the full stack; write run.json and run.png; the record.
+
+    ``robot_face="ros2"``: the simulated robot is a ROS 2 robot over rmw_zenoh, reached
+    through the ros2 backends of the laser driver and motor bridge."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
         raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
     params = stack_params(scenario, scenario_path, planner)
+    if robot_face not in ROBOT_FACES:
+        raise ConfigError(f"--robot {robot_face!r}: choose one of {', '.join(ROBOT_FACES)}")
+    if robot_face == "ros2":
+        params = with_ros2_robot(params)
     for text in overrides or []:
         apply_override(params, text)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -20,7 +20,8 @@ def _run(args: argparse.Namespace) -> int:
 
     try:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
-                              overrides=args.set, log_level=args.log_level)
+                              overrides=args.set, log_level=args.log_level,
+                              robot_face=args.robot)
     except (ScenarioError, ConfigError) as exc:
         # one line, every problem in it: "file: field: problem; file: field: problem"
         print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
@@ -62,6 +63,9 @@ def add_commands(sub: Any) -> None:
     run.add_argument("--set", action="append", default=[], metavar="SERVICE.NAME=VALUE",
                      help="override a service parameter, e.g. perception.lambda_=1.5")
     run.add_argument("--log-level", default="INFO", help="services' log level")
+    run.add_argument("--robot", choices=["native", "ros2"], default="native",
+                     help="how the simulated robot talks to the stack: zenav's device keys "
+                          "(native) or ROS 2 over rmw_zenoh (/scan, /odom, /cmd_vel)")
     run.set_defaults(func=_run)
 
     service = sub.add_parser("service", help="run one service process",

@@ -1,10 +1,13 @@
-"""Laser driver parameters: the scanner's geometry."""
+"""Laser driver parameters: the scanner's geometry, and where its data comes from."""
 
 from __future__ import annotations
+
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from zenav.services.mission import RANGE_MAX
+from zenav.services.ros2.params import Ros2Params
 
 
 class Params(BaseModel):
@@ -19,6 +22,11 @@ class Params(BaseModel):
     range_max: float = Field(RANGE_MAX, gt=0,
                              description="longest range, m; reported for no return")
     rate_hz: float = Field(10.0, gt=0, description="scan rate, Hz")
+    backend: Literal["native", "ros2"] = Field(
+        "native", description="native: raw frames on device/laser; ros2: LaserScan and "
+        "Odometry from a ROS 2 robot over rmw_zenoh (geometry taken from each scan)")
+    ros2: Ros2Params = Field(default_factory=Ros2Params, description="the ROS 2 robot's "
+                             "topics, frames and domain (ros2 backend)")
 
     @model_validator(mode="after")
     def _whole_beams(self) -> Params:

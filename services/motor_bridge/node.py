@@ -5,6 +5,10 @@ here), clamped to the speed and acceleration limits, and commands zero velocity 
 commands go stale. Staleness is judged on the stamps' clock: the latest odometry stamp
 tells the bridge what time it is. In real-time mode a wall-clock watchdog also stops the
 robot when nothing at all arrives (a cut link, a dead planner host).
+
+Backends, chosen by ``backend``: ``native`` sends :class:`BaseCommand` on
+``device/base_cmd`` (the simulator, or a base's own driver process); ``ros2`` also sends
+each command to a ROS 2 robot's ``cmd_vel`` over rmw_zenoh (:mod:`.output`).
 """
 
 from __future__ import annotations
@@ -16,8 +20,10 @@ import time
 from zenav.schemas import keys
 from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCommand
 from zenav.services.motor_bridge.command_filter import CommandFilter, Limiter
+from zenav.services.motor_bridge.output import BaseOutput
 from zenav.services.motor_bridge.params import Params
 from zenav.services.node import Node, StampGate
+from zenav.services.ros2.node import Ros2Node, Ros2Publisher
 
 __all__ = ["CommandFilter", "Limiter", "Params", "Service"]
 # Params and CommandFilter are also read from here by zenav/inprocess.py.
@@ -33,7 +39,15 @@ class Service:
         self.params = params
         self.filter = CommandFilter(params)
         self.limiter = self.filter.limiter
-        self.base = node.publisher(keys.BASE_CMD, BaseCommand, reliable=True, urgent=True)
+        native = node.publisher(keys.BASE_CMD, BaseCommand, reliable=True, urgent=True)
+        self.ros: Ros2Node | None = None
+        ros_out: Ros2Publisher | None = None
+        if params.backend == "ros2":
+            r = params.ros2
+            self.ros = Ros2Node(node.bus, r.node_name or "zenav_motor_bridge", r.domain_id,
+                                r.namespace)
+            ros_out = self.ros.publisher(r.topic(r.cmd_vel_topic), r.cmd_vel_type)
+        self.base = BaseOutput(native, ros_out, params.ros2)
         self.gate = StampGate(node, keys.CMD_VEL)
         self.now: float | None = None  # latest stamp seen: the stack's clock
         self.last_command_stamp: float | None = None
@@ -96,6 +110,11 @@ class Service:
         self.base.publish(
             BaseCommand(stamp=stamp, seq=self.base.next_seq(), v=0.0, omega=0.0, reason="stale")
         )
+
+    def close(self) -> None:
+        """Leave the ROS 2 graph (the runner calls this after the node stops)."""
+        if self.ros is not None:
+            self.ros.close()
 
     async def run(self) -> None:
         """The wall-clock watchdog, in real-time mode only."""

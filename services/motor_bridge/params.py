@@ -1,4 +1,5 @@
-"""Motor bridge parameters: speed and acceleration limits, staleness, the stop zone."""
+"""Motor bridge parameters: speed and acceleration limits, staleness, the stop zone, and
+where base commands go."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.services.mission import ACCEL, DECEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS
+from zenav.services.ros2.params import Ros2Params
 
 
 class Params(BaseModel):
@@ -37,3 +39,8 @@ class Params(BaseModel):
                                "front at standstill, m")
     zone_reaction: float = Field(0.3, ge=0, description="s of travel added to the zone: one "
                                  "command period and some")
+    backend: Literal["native", "ros2"] = Field(
+        "native", description="native: BaseCommand on device/base_cmd only; ros2: also "
+        "Twist (or TwistStamped) to a ROS 2 robot over rmw_zenoh")
+    ros2: Ros2Params = Field(default_factory=Ros2Params, description="the ROS 2 robot's "
+                             "topics, frames and domain (ros2 backend)")
