@@ -68,7 +68,7 @@ def test_marker_array():
     assert [m.id for m in arrows] == [1]  # only the moving track
     start, end = arrows[0].points
     assert (end.x - start.x, end.y - start.y) == pytest.approx((0.4, 0.3))
-    text = [m for m in markers if m.ns == "planner"][0]
+    text = next(m for m in markers if m.ns == "planner")
     assert text.type == view.TEXT and text.text == "(c) slow 0.10 m/s"
     assert all(m.header.frame_id == "odom" for m in markers[1:])
 

@@ -47,7 +47,8 @@ def test_liveliness_tokens_match_the_design_document():
         f"std_msgs::msg::dds_::String_/{STRING_HASH}/::,7:,:,:,,")
     listener = NodeIdentity(domain_id=2, session_id="aac3178e146ba6f1fc6e6a4085e77f21",
                             name="listener")
-    assert listener.node_token() == "@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/0/NN/%/%/listener"
+    assert listener.node_token() == (
+        "@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/0/NN/%/%/listener")
     assert listener.entity_token(10, "MS", "/chatter", "std_msgs/msg/String", QoS()) == (
         "@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/10/MS/%/%/listener/%chatter/"
         f"std_msgs::msg::dds_::String_/{STRING_HASH}/::,10:,:,:,,")
