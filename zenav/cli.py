@@ -9,7 +9,7 @@ import sys
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from zenav import graph, paper, paramscmd, stackcmd
+    from zenav import graph, paper, paramscmd, rviz, stackcmd
     from zenav.bag import record, replay
     from zenav.bench import cli as bench
     from zenav.deploy import commands as deploy
@@ -30,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     record.add_command(sub)
     replay.add_command(sub)
     graph.add_command(sub)
+    rviz.add_command(sub)
     bench.add_commands(sub)  # bench perf|nav|accuracy, soak
     return parser
 

@@ -1,0 +1,117 @@
+"""``zenav rviz``: zenav's view for RViz on a ROS 2 robot's own wire (rmw_zenoh).
+
+Read-only, from any host: it follows zenav's tracks and planner state and publishes
+``visualization_msgs/msg/MarkerArray`` on ``/zenav/markers`` (a cylinder per tracked
+obstacle coloured by type, a velocity arrow per mover, the planner's scenario letter and
+action as text above the robot), in the odometry frame. In RViz: Add > By topic >
+/zenav/markers. The global path (``nav_msgs/msg/Path``) follows once the planner
+publishes one (:func:`zenav.services.ros2.view.path_to_ros` builds it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import sys
+from typing import Any
+
+from zenav.schemas import keys
+from zenav.schemas.codec import DecodeError, decode
+from zenav.schemas.keys import Keys
+from zenav.schemas.messages import PlannerState, TrackList
+from zenav.services.ros2.node import Ros2Node
+from zenav.services.ros2.view import tracks_to_markers
+from zenav.services.ros2.wire import MARKER_ARRAY, WireError, qualify
+from zenav.services.runner import add_transport_arguments
+from zenav.services.transport import Bus, ZenohBus
+from zenav.tooling import stop_on_signals, tool_setup
+
+
+class RvizView:
+    """Tracks and planner state in, MarkerArray out (one per track list)."""
+
+    def __init__(self, bus: Bus, robot_id: str, *, domain_id: int = 0,
+                 topic: str = "/zenav/markers", frame: str = "odom",
+                 node_name: str = "zenav_view") -> None:
+        self.keys = Keys(robot_id)
+        self.frame = frame
+        self.ros = Ros2Node(bus, node_name, domain_id)
+        self.markers = self.ros.publisher(qualify(topic), MARKER_ARRAY)
+        self.tracks = bus.subscribe(self.keys.of(keys.TRACKS), depth=1)
+        self.states = bus.subscribe(self.keys.of(keys.PLANNER_STATE), depth=1)
+        self.state: PlannerState | None = None
+        self.sent = 0
+
+    def on_state(self, payload: bytes) -> None:
+        with contextlib.suppress(DecodeError):
+            self.state = decode(payload, PlannerState, self.keys.of(keys.PLANNER_STATE))
+
+    def on_tracks(self, payload: bytes) -> None:
+        try:
+            tracks = decode(payload, TrackList, self.keys.of(keys.TRACKS),
+                            keys.TRACKS.max_bytes)
+        except DecodeError:
+            return
+        self.markers.publish(tracks_to_markers(tracks, self.frame, self.state))
+        self.sent += 1
+
+    async def run(self) -> None:
+        async def states() -> None:
+            while True:
+                self.on_state((await self.states.get())[1])
+
+        task = asyncio.get_running_loop().create_task(states())
+        try:
+            while True:
+                self.on_tracks((await self.tracks.get())[1])
+        finally:
+            task.cancel()
+
+    def close(self) -> None:
+        self.tracks.close()
+        self.states.close()
+        self.ros.close()
+
+
+async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None:
+    stop = asyncio.Event()
+    stop_on_signals(stop)
+    bus = ZenohBus(transport, asyncio.get_running_loop())
+    view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame)
+    task = asyncio.get_running_loop().create_task(view.run())
+    try:
+        await stop.wait()
+    finally:
+        task.cancel()
+        with contextlib.suppress(asyncio.CancelledError):
+            await task
+        view.close()
+        bus.close()
+
+
+def main(args: argparse.Namespace) -> int:
+    setup = tool_setup(args, "rviz")
+    if setup is None:
+        return 2
+    try:
+        qualify(args.topic)
+    except WireError as exc:
+        print(f"zenav rviz: --topic: {exc}", file=sys.stderr)
+        return 2
+    robot_id, transport = setup
+    with contextlib.suppress(KeyboardInterrupt):
+        asyncio.run(serve(transport, robot_id, args))
+    return 0
+
+
+def add_command(sub: Any) -> None:
+    rviz = sub.add_parser(
+        "rviz", help="publish zenav's tracks and planner state for RViz over rmw_zenoh",
+        description="Tracked obstacles (type colour, velocity arrows) and the planner's "
+        "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic.")
+    rviz.add_argument("--domain-id", type=int, default=0, help="ROS_DOMAIN_ID (default 0)")
+    rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
+    rviz.add_argument("--frame", default="odom", help="frame of zenav's poses (default odom)")
+    add_transport_arguments(rviz)
+    rviz.set_defaults(func=main)
