@@ -70,10 +70,14 @@ def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> 
     }
 
 
-async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, list[PlannerEvent]]:
-    """Join the stack, gather events until the simulator's result arrives."""
+async def _collect(stack: Stack, progress_timeout: float,
+                   record: Path | None = None) -> tuple[RunResult, list[PlannerEvent]]:
+    """Join the stack, gather events until the simulator's result arrives; with
+    ``record``, write every message of the run there as MCAP (zenav's msgpack channels and
+    the Foxglove ones)."""
     k = Keys(stack.robot_id)
     bus = ZenohBus(stack.transport(driver=True), asyncio.get_running_loop())
+    recording = _Recording(bus, record, stack.robot_id) if record is not None else None
     try:
         # Announce this run (the simulator waits for it) only once every service is
         # seen from here: peers relay nothing, so each must be linked to this process.
@@ -149,7 +153,26 @@ async def _collect(stack: Stack, progress_timeout: float) -> tuple[RunResult, li
         token.undeclare()
         return result, events
     finally:
+        if recording is not None:
+            recording.close()
         bus.close()
+
+
+class _Recording:
+    """Every message of the run into an MCAP file, subscribed before the run starts."""
+
+    def __init__(self, bus: ZenohBus, path: Path, robot_id: str) -> None:
+        from zenav.bag.mcapfile import BagWriter
+        from zenav.tooling import StampedSubscriber
+
+        self.stream = path.open("wb")
+        self.writer = BagWriter(self.stream, robot_id, foxglove=True)
+        self.subscriber = StampedSubscriber(bus, self.writer.keys.everything, self.writer.add)
+
+    def close(self) -> None:
+        self.subscriber.close()
+        self.writer.close()
+        self.stream.close()
 
 
 def run_scenario(
@@ -161,11 +184,13 @@ def run_scenario(
     log_level: str = "INFO",
     picture: bool = True,
     robot_face: str = "native",
+    record: bool = False,
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record.
 
     ``robot_face="ros2"``: the simulated robot is a ROS 2 robot over rmw_zenoh, reached
-    through the ros2 backends of the laser driver and motor bridge."""
+    through the ros2 backends of the laser driver and motor bridge. ``record``: also
+    ``run.mcap``, every message of the run, openable in Foxglove."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
         raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
@@ -181,7 +206,8 @@ def run_scenario(
     started = time.monotonic()
     stack.start()
     try:
-        result, events = asyncio.run(_collect(stack, progress_timeout))
+        result, events = asyncio.run(_collect(stack, progress_timeout,
+                                              out_dir / "run.mcap" if record else None))
     finally:
         codes = stack.stop()
     record = make_record(result, events, planner)

@@ -21,7 +21,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level,
-                              robot_face=args.robot)
+                              robot_face=args.robot, record=args.record)
     except (ScenarioError, ConfigError) as exc:
         # one line, every problem in it: "file: field: problem; file: field: problem"
         print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
@@ -66,6 +66,9 @@ def add_commands(sub: Any) -> None:
     run.add_argument("--robot", choices=["native", "ros2"], default="native",
                      help="how the simulated robot talks to the stack: zenav's device keys "
                           "(native) or ROS 2 over rmw_zenoh (/scan, /odom, /cmd_vel)")
+    run.add_argument("--record", action="store_true",
+                     help="also write DIR/run.mcap: every message of the run, with Foxglove "
+                          "channels (opens in Foxglove)")
     run.set_defaults(func=_run)
 
     service = sub.add_parser("service", help="run one service process",

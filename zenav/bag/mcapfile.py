@@ -61,7 +61,9 @@ def _stamp_and_seq(payload: bytes) -> tuple[int | None, int]:
 class BagWriter:
     """Writes one robot's messages and liveliness changes to an MCAP stream."""
 
-    def __init__(self, stream: IO[bytes], robot_id: str, exclude: tuple[str, ...] = ()) -> None:
+    def __init__(self, stream: IO[bytes], robot_id: str, exclude: tuple[str, ...] = (),
+                 foxglove: bool = False) -> None:
+        """``foxglove``: also write the Foxglove channels (:mod:`zenav.foxglove`)."""
         self.keys = Keys(robot_id)
         self._prefix = self.keys.prefix + "/"
         self._exclude = set(exclude)
@@ -76,6 +78,11 @@ class BagWriter:
         self._channels: dict[str, int] = {}
         self.count = 0
         self._closed = False
+        self.foxglove: Any = None
+        if foxglove:
+            from zenav.foxglove.recording import FoxgloveChannels  # imports this module
+
+            self.foxglove = FoxgloveChannels(self._writer, robot_id)
 
     def _schema(self, message: type[Message]) -> int:
         if message not in self._schemas:
@@ -104,6 +111,8 @@ class BagWriter:
                                  publish_time=stamp_ns if stamp_ns is not None else log_time_ns,
                                  sequence=seq)
         self.count += 1
+        if self.foxglove is not None:
+            self.foxglove.add(key, payload, log_time_ns)
 
     def liveliness(self, key: str, alive: bool, log_time_ns: int) -> None:
         if self._closed:

@@ -1,4 +1,5 @@
-"""``zenav record``: a robot's messages and liveliness changes into an MCAP file."""
+"""``zenav record``: a robot's messages and liveliness changes into an MCAP file, with
+the same data in Foxglove's well-known schemas beside them (:mod:`zenav.foxglove`)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ async def record(transport: Any, robot_id: str, path: Path, *, duration: float |
     changes = 0
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("wb") as stream:
-        writer = BagWriter(stream, robot_id, exclude)
+        writer = BagWriter(stream, robot_id, exclude, foxglove=True)
         bus = ZenohBus(transport, loop)
         try:
             subscriber = StampedSubscriber(bus, writer.keys.everything, writer.add)

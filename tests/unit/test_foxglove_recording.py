@@ -1,0 +1,121 @@
+"""The Foxglove channels of a recording, decoded with the schemas stored in the file (the
+ones the Foxglove SDK publishes), as Foxglove itself reads them."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+from tests.ros2 import samples
+from zenav.bag.mcapfile import BagWriter
+from zenav.foxglove.scene import TOPICS
+from zenav.schemas.codec import encode
+from zenav.schemas.messages import (
+    GroundTruth,
+    Obstacle,
+    ObstacleChain,
+    ObstacleTruth,
+    PlannerEvent,
+    Pose2D,
+)
+
+NS = 1_000_000_000
+
+
+def obstacle_chain(stamp: float) -> ObstacleChain:
+    ob = Obstacle(x=2.0, y=1.0, rho=2.2, alpha=0.4, cells=(1, 2, 3, 4), area=4, beams=(10, 20),
+                  n_beams=11, first=(1.9, 0.9), last=(2.1, 1.1), chord=(2.0, 1.0), radius=0.25,
+                  edges=(0, 0))
+    return ObstacleChain(stamp=stamp, seq=0, pose=Pose2D(x=0.0, y=0.0, heading=0.0),
+                         window_radius=3.0, cell=0.1, obstacles=[ob])
+
+
+def truth(stamp: float) -> GroundTruth:
+    return GroundTruth(stamp=stamp, seq=0, pose=Pose2D(x=0.5, y=0.0, heading=0.1), v=0.2,
+                       obstacles=[ObstacleTruth(index=0, shape="disc", x=3.0, y=0.0,
+                                                size=(0.6, 0.6), vx=-0.5, vy=0.0),
+                                  ObstacleTruth(index=1, shape="box", x=1.0, y=2.0,
+                                                size=(1.0, 0.5), vx=0.0, vy=0.0)])
+
+
+def event(stamp: float) -> PlannerEvent:
+    return PlannerEvent(stamp=stamp, seq=0, obstacle=1, kind="dynamic", scenario="f",
+                        action="morphin", detail="head-on")
+
+
+@pytest.fixture
+def decoded():
+    stream = io.BytesIO()
+    writer = BagWriter(stream, "r1", foxglove=True)
+    t = 12.5
+    for topic, message in (("odom", samples.odometry(t)), ("scan", samples.scan(t)),
+                           ("obstacles", obstacle_chain(t)), ("tracks", samples.tracks(t)),
+                           ("planner/state", samples.state(t)), ("sim/truth", truth(t)),
+                           ("planner/events", event(t))):
+        writer.add(f"zenav/r1/{topic}", encode(message), 20 * NS)
+    writer.close()
+    stream.seek(0)
+    reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+    out: dict[str, list] = {}
+    schemas = {}
+    for schema, channel, message, proto in reader.iter_decoded_messages(
+            topics=list(TOPICS)):
+        assert channel.message_encoding == "protobuf" and schema.encoding == "protobuf"
+        assert message.publish_time == 12_500_000_000 and message.log_time == 20 * NS
+        schemas[channel.topic] = schema.name
+        out.setdefault(channel.topic, []).append(proto)
+    return out, schemas
+
+
+def test_every_foxglove_topic_is_written_with_its_schema(decoded):
+    out, schemas = decoded
+    assert set(out) == set(TOPICS)
+    for topic, message_type in TOPICS.items():
+        assert schemas[topic] == message_type.get_schema().name
+
+
+def test_scan_transforms_and_pose(decoded):
+    out, _ = decoded
+    scan = out["/foxglove/scan"][0]
+    assert scan.frame_id == "laser" and len(scan.ranges) == 361
+    assert scan.start_angle == pytest.approx(-math.pi / 2)
+    assert math.isinf(scan.ranges[10]) and scan.ranges[0] == pytest.approx(0.5)
+    assert (scan.timestamp.seconds, scan.timestamp.nanos) == (12, 500_000_000)
+    frames = {(t.parent_frame_id, t.child_frame_id): t for t in out["/foxglove/tf"]}
+    assert set(frames) == {("odom", "base_link"), ("base_link", "laser")}
+    robot = frames[("odom", "base_link")]
+    assert (robot.translation.x, robot.translation.y) == (1.25, -0.5)
+    assert 2 * math.atan2(robot.rotation.z, robot.rotation.w) == pytest.approx(2.0)
+    pose = out["/foxglove/pose"][0]
+    assert pose.frame_id == "odom" and pose.pose.position.x == 1.25
+
+
+def test_scene_updates(decoded):
+    out, _ = decoded
+    tracks = out["/foxglove/tracks"][0]
+    assert len(tracks.deletions) == 1  # each update replaces the last one
+    entities = {e.id: e for e in tracks.entities}
+    assert set(entities) == {"track-1", "track-2", "track-3"}
+    mover = entities["track-1"]
+    assert mover.frame_id == "odom" and len(mover.arrows) == 1
+    assert mover.cylinders[0].color.r == pytest.approx(0.9)  # dynamic: red
+    assert mover.texts[0].text == "1 dynamic"
+    assert entities["track-2"].arrows == []  # standing: no arrow
+    obstacles = out["/foxglove/obstacles"][0].entities[0]
+    assert obstacles.cylinders[0].pose.position.x == 2.0
+    plan = out["/foxglove/plan"][0].entities[0]
+    assert plan.texts[0].text == "(c) slow 0.10 m/s"
+    assert [(p.x, p.y) for p in plan.lines[0].points] == [(1.25, -0.5), (3.0, 4.0)]
+    truth_entities = {e.id: e for e in out["/foxglove/truth"][0].entities}
+    assert len(truth_entities["truth"].cylinders) == 1 and len(truth_entities["truth"].cubes) == 1
+
+
+def test_planner_events_are_log_lines(decoded):
+    out, _ = decoded
+    (line,) = out["/foxglove/log"]
+    assert line.name == "planner" and line.message == "(f) morphin obstacle 1 (dynamic): head-on"
+    assert line.level == 2  # INFO in foxglove.Log
