@@ -14,6 +14,7 @@ def build_parser() -> argparse.ArgumentParser:
     from zenav.bench import cli as bench
     from zenav.deploy import commands as deploy
     from zenav.deploy import router
+    from zenav.foxglove import live as foxglove_live
     from zenav.monitor import command as monitor
 
     parser = argparse.ArgumentParser(
@@ -31,6 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_command(sub)
     graph.add_command(sub)
     rviz.add_command(sub)
+    foxglove_live.add_command(sub)
     bench.add_commands(sub)  # bench perf|nav|accuracy, soak
     return parser
 

@@ -17,17 +17,17 @@ pytestmark = pytest.mark.integration
 SCENARIO = Path(__file__).parents[2] / "sim" / "scenarios" / "paper-mixed.yaml"
 
 
-def run(out: Path, robot: str) -> dict:
+def run(out: Path, robot: str, *extra: str) -> dict:
     done = subprocess.run(
         [sys.executable, "-m", "zenav", "run", str(SCENARIO), "--out", str(out), "--robot",
-         robot], capture_output=True, text=True, timeout=240, check=False)
+         robot, *extra], capture_output=True, text=True, timeout=300, check=False)
     assert done.returncode == 0, done.stderr[-2000:]
     return json.loads((out / "run.json").read_text())
 
 
 def test_ros2_robot_reaches_the_same_outcome_as_native(tmp_path):
     ros2 = run(tmp_path / "ros2", "ros2")
-    native = run(tmp_path / "native", "native")
+    native = run(tmp_path / "native", "native", "--record")
     assert ros2["outcome"] == native["outcome"] == "reached"
     assert ros2["time"] == native["time"]
     assert ros2["events"] == native["events"]
@@ -37,3 +37,29 @@ def test_ros2_robot_reaches_the_same_outcome_as_native(tmp_path):
     assert "unclean_exits" not in ros2
     logs = (tmp_path / "ros2" / "logs" / "laser_driver.log").read_text()
     assert "rejected input" not in logs
+    check_recording(tmp_path / "native" / "run.mcap", native)
+
+
+def check_recording(path: Path, record: dict) -> None:
+    """run.mcap beside run.json: every Foxglove channel decodes with the schema stored for
+    it, and the msgpack channels are still there."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
+    from zenav.foxglove.scene import TOPICS
+
+    counts: dict[str, int] = {}
+    with path.open("rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for schema, channel, _, decoded in reader.iter_decoded_messages(topics=list(TOPICS)):
+            assert schema.name == TOPICS[channel.topic].get_schema().name
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            if channel.topic == "/foxglove/log":
+                assert decoded.name == "planner"
+    with path.open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    topics = {c.topic for c in summary.channels.values()}
+    assert {"zenav/robot0/scan", "zenav/robot0/tracks", "zenav/robot0/odom"} <= topics
+    assert set(counts) == set(TOPICS)
+    assert counts["/foxglove/log"] == len(record["events"])

@@ -119,3 +119,14 @@ def test_planner_events_are_log_lines(decoded):
     (line,) = out["/foxglove/log"]
     assert line.name == "planner" and line.message == "(f) morphin obstacle 1 (dynamic): head-on"
     assert line.level == 2  # INFO in foxglove.Log
+
+
+def test_the_shipped_layout_is_the_one_the_code_builds():
+    from pathlib import Path
+
+    from zenav.foxglove.layout import layout_json
+
+    shipped = Path(__file__).resolve().parents[2] / "deploy" / "foxglove" / "zenav.json"
+    assert shipped.read_text() == layout_json()
+    assert '"panelType": "ThreeDee"' in shipped.read_text()
+    assert '"/foxglove/tracks"' in shipped.read_text()

@@ -1,0 +1,97 @@
+"""``zenav foxglove``: a robot's messages served live to Foxglove, read-only.
+
+It joins the bus like the monitor (``--connect ENDPOINT`` from any host), converts each
+sample with the same step as recordings (:class:`zenav.foxglove.recording.SampleConverter`)
+and logs it on the Foxglove SDK's WebSocket server (Foxglove's WebSocket protocol). In
+Foxglove: Open connection > Foxglove WebSocket > ``ws://HOST:8765``; the layout in
+``deploy/foxglove/zenav.json`` shows the 3D scene, the scan and the planner's log.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import sys
+from typing import Any
+
+import foxglove
+from foxglove import channels
+
+from zenav.foxglove.recording import SampleConverter
+from zenav.foxglove.scene import TOPICS
+from zenav.services.runner import add_transport_arguments
+from zenav.services.transport import ZenohBus
+from zenav.tooling import StampedSubscriber, stop_on_signals, tool_setup
+
+
+class LiveChannels:
+    """One Foxglove SDK channel per topic, in a context of their own."""
+
+    def __init__(self, robot_id: str) -> None:
+        self.context = foxglove.Context()
+        self.converter = SampleConverter(robot_id)
+        self.channels: dict[str, Any] = {
+            topic: getattr(channels, f"{kind.__name__}Channel")(topic, context=self.context)
+            for topic, kind in TOPICS.items()
+        }
+        self.count = 0
+
+    def add(self, key: str, payload: bytes, log_time_ns: int) -> None:
+        for topic, message, _ in self.converter.convert(key, payload):
+            self.channels[topic].log(message, log_time=log_time_ns)
+            self.count += 1
+
+
+async def serve(transport: Any, robot_id: str, host: str, port: int,
+                duration: float | None = None) -> None:
+    loop = asyncio.get_running_loop()
+    stop = asyncio.Event()
+    stop_on_signals(stop)
+    if duration is not None:
+        loop.call_later(duration, stop.set)
+    live = LiveChannels(robot_id)
+    server = foxglove.start_server(name=f"zenav {robot_id}", host=host, port=port,
+                                   context=live.context)
+    bus = ZenohBus(transport, loop)
+    subscriber = StampedSubscriber(bus, live.converter.keys.everything, live.add)
+    print(f"zenav foxglove: serving {live.converter.keys.everything} on "
+          f"ws://{host}:{server.port}", flush=True)
+    try:
+        await stop.wait()
+    finally:
+        subscriber.close()
+        bus.close()
+        server.stop()
+
+
+def main(args: argparse.Namespace) -> int:
+    setup = tool_setup(args, "foxglove")
+    if setup is None:
+        return 2
+    if not 0 <= args.port <= 65535:
+        print(f"zenav foxglove: --port {args.port} is not a TCP port", file=sys.stderr)
+        return 2
+    robot_id, transport = setup
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            asyncio.run(serve(transport, robot_id, args.host, args.port, args.duration))
+    except RuntimeError as exc:  # the SDK's server could not bind
+        print(f"zenav foxglove: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def add_command(sub: Any) -> None:
+    parser = sub.add_parser(
+        "foxglove", help="serve a robot's messages live to Foxglove (WebSocket, read-only)",
+        description="Foxglove's WebSocket protocol through the Foxglove SDK's server: the "
+        "scan, the robot's frames and pose, obstacles, tracks, the planner's target and "
+        "events, and ground truth in simulation. --connect ENDPOINT joins a router as a "
+        "client from any host.")
+    parser.add_argument("--host", default="127.0.0.1",
+                        help="address to serve on (default 127.0.0.1; 0.0.0.0 for any host)")
+    parser.add_argument("--port", type=int, default=8765, help="WebSocket port (default 8765)")
+    parser.add_argument("--duration", type=float, help="stop after this many s")
+    add_transport_arguments(parser)
+    parser.set_defaults(func=main)
