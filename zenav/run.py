@@ -184,12 +184,12 @@ def run_scenario(
     log_level: str = "INFO",
     picture: bool = True,
     robot_face: str = "native",
-    record: bool = False,
+    mcap: bool = False,
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record.
 
     ``robot_face="ros2"``: the simulated robot is a ROS 2 robot over rmw_zenoh, reached
-    through the ros2 backends of the laser driver and motor bridge. ``record``: also
+    through the ros2 backends of the laser driver and motor bridge. ``mcap``: also
     ``run.mcap``, every message of the run, openable in Foxglove."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
@@ -207,7 +207,7 @@ def run_scenario(
     stack.start()
     try:
         result, events = asyncio.run(_collect(stack, progress_timeout,
-                                              out_dir / "run.mcap" if record else None))
+                                              out_dir / "run.mcap" if mcap else None))
     finally:
         codes = stack.stop()
     record = make_record(result, events, planner)

@@ -21,7 +21,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level,
-                              robot_face=args.robot, record=args.record)
+                              robot_face=args.robot, mcap=args.record)
     except (ScenarioError, ConfigError) as exc:
         # one line, every problem in it: "file: field: problem; file: field: problem"
         print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
