@@ -11,7 +11,9 @@ import struct
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 import zenoh
@@ -31,7 +33,7 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def message_class(channel: dict):
+def message_class(channel: dict[str, Any]) -> Any:
     """A protobuf class from a channel's advertised schema (a FileDescriptorSet)."""
     assert channel["encoding"] == "protobuf" and channel["schemaEncoding"] == "protobuf"
     files = descriptor_pb2.FileDescriptorSet.FromString(base64.b64decode(channel["schema"]))
@@ -41,12 +43,13 @@ def message_class(channel: dict):
     return message_factory.GetMessageClass(pool.FindMessageTypeByName(channel["schemaName"]))
 
 
-async def receive(url: str, publish, timeout: float = 30.0) -> dict[str, object]:
+async def receive(url: str, publish: Callable[[], None],
+                  timeout: float = 30.0) -> dict[str, Any]:
     """Subscribe to the scan and tracks; publish zenav messages until both arrive."""
-    got: dict[str, object] = {}
+    got: dict[str, Any] = {}
     async with websockets.connect(url, subprotocols=["foxglove.sdk.v1", "foxglove.websocket.v1"],
                                   open_timeout=10) as ws:
-        channels: dict[str, dict] = {}
+        channels: dict[str, dict[str, Any]] = {}
         deadline = time.monotonic() + timeout
         while not {"/foxglove/scan", "/foxglove/tracks"} <= set(channels):
             frame = json.loads(await asyncio.wait_for(ws.recv(), deadline - time.monotonic()))
@@ -108,8 +111,8 @@ def test_live_scan_and_scene_update_reach_a_websocket_client(tmp_path: Path):
             except subprocess.TimeoutExpired:
                 proc.kill()
     scan = got["/foxglove/scan"]
-    assert scan.frame_id == "laser" and len(scan.ranges) == 361  # type: ignore[attr-defined]
-    assert scan.ranges[0] == pytest.approx(0.5)  # type: ignore[attr-defined]
+    assert scan.frame_id == "laser" and len(scan.ranges) == 361
+    assert scan.ranges[0] == pytest.approx(0.5)
     update = got["/foxglove/tracks"]
-    assert {e.id for e in update.entities} == {"track-1", "track-2", "track-3"}  # type: ignore[attr-defined]
-    assert len(next(e for e in update.entities if e.id == "track-1").arrows) == 1  # type: ignore[attr-defined]
+    assert {e.id for e in update.entities} == {"track-1", "track-2", "track-3"}
+    assert len(next(e for e in update.entities if e.id == "track-1").arrows) == 1

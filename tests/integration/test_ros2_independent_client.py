@@ -11,6 +11,7 @@ separate processes, clients of the router.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import socket
@@ -78,7 +79,8 @@ def network(tmp_path: Path) -> Iterator[dict[str, Any]]:
     conf.insert_json5("mode", '"router"')
     conf.insert_json5("listen/endpoints", json.dumps([endpoint]))
     conf.insert_json5("scouting/multicast/enabled", "false")
-    router = zenoh.open(conf)
+    stack = contextlib.ExitStack()
+    stack.enter_context(zenoh.open(conf))  # the router, as rmw_zenohd would be
     procs = []
     for name in ("laser_driver", "motor_bridge"):
         log = (tmp_path / f"{name}.log").open("w")
@@ -89,7 +91,7 @@ def network(tmp_path: Path) -> Iterator[dict[str, Any]]:
     client_conf = zenoh.Config()
     client_conf.insert_json5("mode", '"client"')
     client_conf.insert_json5("connect/endpoints", json.dumps([endpoint]))
-    zenav_side = zenoh.open(client_conf)
+    zenav_side = stack.enter_context(zenoh.open(client_conf))
     defs = tmp_path / "msg"
     write_definitions(defs)
     from zenoh_ros2_sdk import message_registry
@@ -111,8 +113,7 @@ def network(tmp_path: Path) -> Iterator[dict[str, Any]]:
         if ZenohSession._instance is not None:
             ZenohSession._instance.close()
         message_registry._registry = None
-        zenav_side.close()
-        router.close()
+        stack.close()
 
 
 def test_sdk_robot_and_zenav_understand_each_other(network):

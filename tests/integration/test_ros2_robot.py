@@ -9,6 +9,7 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -17,12 +18,13 @@ pytestmark = pytest.mark.integration
 SCENARIO = Path(__file__).parents[2] / "sim" / "scenarios" / "paper-mixed.yaml"
 
 
-def run(out: Path, robot: str, *extra: str) -> dict:
+def run(out: Path, robot: str, *extra: str) -> dict[str, Any]:
     done = subprocess.run(
         [sys.executable, "-m", "zenav", "run", str(SCENARIO), "--out", str(out), "--robot",
          robot, *extra], capture_output=True, text=True, timeout=300, check=False)
     assert done.returncode == 0, done.stderr[-2000:]
-    return json.loads((out / "run.json").read_text())
+    record: dict[str, Any] = json.loads((out / "run.json").read_text())
+    return record
 
 
 def test_ros2_robot_reaches_the_same_outcome_as_native(tmp_path):
@@ -40,7 +42,7 @@ def test_ros2_robot_reaches_the_same_outcome_as_native(tmp_path):
     check_recording(tmp_path / "native" / "run.mcap", native)
 
 
-def check_recording(path: Path, record: dict) -> None:
+def check_recording(path: Path, record: dict[str, Any]) -> None:
     """run.mcap beside run.json: every Foxglove channel decodes with the schema stored for
     it, and the msgpack channels are still there."""
     from mcap.reader import make_reader
@@ -52,6 +54,7 @@ def check_recording(path: Path, record: dict) -> None:
     with path.open("rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
         for schema, channel, _, decoded in reader.iter_decoded_messages(topics=list(TOPICS)):
+            assert schema is not None
             assert schema.name == TOPICS[channel.topic].get_schema().name
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
             if channel.topic == "/foxglove/log":

@@ -24,7 +24,7 @@ def odometry(stamp: float = 12.5) -> Odometry:
 
 def track(ident: int, kind: str = "dynamic", vx: float = 0.4, vy: float = 0.3) -> Track:
     speed = math.hypot(vx, vy)
-    return Track(id=ident, kind=kind, x=2.0 + ident, y=1.0, vx=vx, vy=vy, speed=speed,  # type: ignore[arg-type]
+    return Track(id=ident, kind=kind, x=2.0 + ident, y=1.0, vx=vx, vy=vy, speed=speed,
                  heading=math.atan2(vy, vx), radius=0.3, xi=0.5, varsigma=0.7,
                  alpha_o_deg=45.0, age=5, cells=(1, 2, 3, 4), area=4)
 

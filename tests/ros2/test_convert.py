@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -13,8 +14,8 @@ from zenav.services.ros2.convert import ConversionError
 from zenav.services.ros2.wire import LASER_SCAN, message_class
 
 
-def ros_scan(ranges, angle_min=-1.0, inc=0.01, rmin=0.1, rmax=10.0, stamp=3.25,
-             angle_max=None):
+def ros_scan(ranges: Any, angle_min: float = -1.0, inc: float = 0.01, rmin: float = 0.1,
+             rmax: float = 10.0, stamp: float = 3.25, angle_max: float | None = None) -> Any:
     ranges = np.asarray(ranges, dtype=np.float32)
     return message_class(LASER_SCAN)(
         header=convert.header(stamp, "base_scan"), angle_min=angle_min,

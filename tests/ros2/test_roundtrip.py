@@ -4,6 +4,7 @@ and back with rosbags: what zenav sends is what a ROS 2 node reads."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -14,7 +15,7 @@ from zenav.services.ros2 import convert, view, wire
 from zenav.services.ros2.params import Ros2Params
 
 
-def through_cdr(message, ros_type):
+def through_cdr(message: Any, ros_type: str) -> Any:
     payload = wire.serialize(message, ros_type)
     assert payload[:4] == b"\x00\x01\x00\x00"  # CDR little-endian encapsulation
     return wire.deserialize(payload, ros_type)

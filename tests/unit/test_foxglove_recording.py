@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import math
+from typing import Any
 
 import pytest
 from mcap.reader import make_reader
@@ -52,19 +53,20 @@ def decoded():
     stream = io.BytesIO()
     writer = BagWriter(stream, "r1", foxglove=True)
     t = 12.5
-    for topic, message in (("odom", samples.odometry(t)), ("scan", samples.scan(t)),
+    for topic, sample in (("odom", samples.odometry(t)), ("scan", samples.scan(t)),
                            ("obstacles", obstacle_chain(t)), ("tracks", samples.tracks(t)),
                            ("planner/state", samples.state(t)), ("sim/truth", truth(t)),
                            ("planner/events", event(t))):
-        writer.add(f"zenav/r1/{topic}", encode(message), 20 * NS)
+        writer.add(f"zenav/r1/{topic}", encode(sample), 20 * NS)
     writer.close()
     stream.seek(0)
     reader = make_reader(stream, decoder_factories=[DecoderFactory()])
-    out: dict[str, list] = {}
+    out: dict[str, list[Any]] = {}
     schemas = {}
     for schema, channel, message, proto in reader.iter_decoded_messages(
             topics=list(TOPICS)):
-        assert channel.message_encoding == "protobuf" and schema.encoding == "protobuf"
+        assert schema is not None and channel.message_encoding == "protobuf"
+        assert schema.encoding == "protobuf"
         assert message.publish_time == 12_500_000_000 and message.log_time == 20 * NS
         schemas[channel.topic] = schema.name
         out.setdefault(channel.topic, []).append(proto)
