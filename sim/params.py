@@ -47,8 +47,9 @@ class Params(BaseModel):
         "native", description="native: zenav's device/* keys and odom; ros2: a ROS 2 robot "
         "over rmw_zenoh (/scan, /odom, /cmd_vel)")
     ros2: Ros2Params = Field(
-        default_factory=lambda: Ros2Params(node_name="zenav_sim_robot"),
-        description="topics, frames and domain of the simulated ROS 2 robot")
+        default_factory=Ros2Params,
+        description="topics, frames and domain of the simulated ROS 2 robot (its node: "
+        "zenav_sim_robot unless ros2.node_name says otherwise)")
 
     @model_validator(mode="after")
     def _stamped_for_lockstep(self) -> Params:
