@@ -143,6 +143,18 @@ class Clusters:
         )
 
 
+def to_global(pose: Pose, rho: npt.ArrayLike, alpha: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Eq. 1: global (x, y) of the points at range ``rho`` and beam angle ``alpha``.
+
+    ``alpha`` is counter-clockwise from the heading (see the module notes), so the paper's
+    ``theta_R - alpha_i`` reads ``theta_R + alpha`` here.
+    """
+    x_r, y_r, th_r = pose
+    r = np.asarray(rho, dtype=np.float64)
+    ang = th_r + np.asarray(alpha, dtype=np.float64)
+    return x_r + r * np.cos(ang), y_r + r * np.sin(ang)
+
+
 def grid_index(coord: npt.ArrayLike, cell: float) -> IntArray:
     """Eq. 2: grid index ``floor(coord / r + 1/2)`` (cell k is centred on k * r)."""
     return np.floor(np.asarray(coord, dtype=np.float64) / cell + 0.5).astype(np.int64)
@@ -165,6 +177,19 @@ def join_threshold(
     """
     step = math.sin(abs(angle_increment))
     return params.lambda_ * np.asarray(rho, dtype=np.float64) * step + params.gap_floor
+
+
+def cluster_means(
+    rho: FloatArray, alpha: FloatArray, starts: IntArray, counts: IntArray
+) -> tuple[FloatArray, FloatArray]:
+    """Eq. 5: mean rho and mean alpha of each cluster.
+
+    The clusters are runs of ``rho`` / ``alpha`` (1-D, back to back) starting at ``starts``
+    with ``counts`` points each.
+    """
+    mean_rho = np.add.reduceat(rho, starts) / counts
+    mean_alpha = np.add.reduceat(alpha, starts) / counts
+    return mean_rho, mean_alpha
 
 
 def cluster_scan(
@@ -194,9 +219,6 @@ def cluster_scan(
     """
     r = np.asarray(ranges, dtype=np.float64)
     cell = params.cell
-    step = math.sin(abs(angle_increment))
-    lam_step = params.lambda_ * step
-    floor_ = params.gap_floor
     # NaN compares False everywhere, so it drops out as "no return" like inf does.
     valid = (r >= range_min) & (r < range_max)
     idx = np.flatnonzero(valid & (r <= params.window_radius))
@@ -206,16 +228,13 @@ def cluster_scan(
     x_r, y_r, th_r = pose
     rho = r[idx]
     alpha = angle_min + idx * angle_increment
-    # Eq. 1 (alpha counter-clockwise, hence theta_R + alpha; the paper writes theta_R - alpha).
-    ang = th_r + alpha
-    px = x_r + rho * np.cos(ang)
-    py = y_r + rho * np.sin(ang)
+    px, py = to_global(pose, rho, alpha)  # Eq. 1
 
     # Eq. 3: a new cluster starts where the distance to the previous point exceeds theta
     # (compared squared, both sides are non-negative).
     dx = px[1:] - px[:-1]
     dy = py[1:] - py[:-1]
-    thr = lam_step * rho[1:] + floor_
+    thr = join_threshold(rho[1:], angle_increment, params)
     breaks = (dx * dx + dy * dy > thr * thr).nonzero()[0] + 1
     m = idx.size
     k = breaks.size + 1
@@ -242,12 +261,8 @@ def cluster_scan(
     k = starts.size
 
     # Eq. 5: mean alpha and mean rho, then Eq. 1 for the global centre.
-    mean_rho = np.add.reduceat(rho, starts) / counts
-    mean_alpha = np.add.reduceat(alpha, starts) / counts
-    ang_c = th_r + mean_alpha
-    centre = np.empty((k, 2))
-    centre[:, 0] = x_r + mean_rho * np.cos(ang_c)
-    centre[:, 1] = y_r + mean_rho * np.sin(ang_c)
+    mean_rho, mean_alpha = cluster_means(rho, alpha, starts, counts)
+    centre = np.column_stack(to_global(pose, mean_rho, mean_alpha))
 
     # Eq. 2 on every point, Eq. 6 box over all of them (S_k's edges, see the module notes).
     # The metric bounding box is shrunk by ``edge_inset`` on each side (never past its
@@ -259,12 +274,9 @@ def cluster_scan(
     lo_y, hi_y = np.minimum.reduceat(py, starts), np.maximum.reduceat(py, starts)
     in_x = np.minimum(inset, (hi_x - lo_x) / 2)
     in_y = np.minimum(inset, (hi_y - lo_y) / 2)
-    box = np.empty((k, 4), dtype=np.int64)
-    box[:, 0] = np.floor((lo_x + in_x) / cell + 0.5)
-    box[:, 1] = np.floor((hi_x - in_x) / cell + 0.5)
-    box[:, 2] = np.floor((lo_y + in_y) / cell + 0.5)
-    box[:, 3] = np.floor((hi_y - in_y) / cell + 0.5)
-    area = (box[:, 1] - box[:, 0] + 1) * (box[:, 3] - box[:, 2] + 1)
+    box = np.column_stack((grid_index(lo_x + in_x, cell), grid_index(hi_x - in_x, cell),
+                           grid_index(lo_y + in_y, cell), grid_index(hi_y - in_y, cell)))
+    area = box_area(box)  # Eq. 6
 
     first_point = np.empty((k, 2))
     first_point[:, 0] = px[starts]
@@ -331,11 +343,11 @@ def _edge_codes(
     has = valid[nb] & ~outside
     rho_e = r[beams]
     rho_n = np.where(has, r[nb], 0.0)  # no arithmetic on inf / NaN readings
-    lam_step = params.lambda_ * math.sin(abs(angle_increment))
     # Distance between the two points by the law of cosines (the angle between them is known).
     d2 = rho_e * rho_e + rho_n * rho_n - (2.0 * math.cos(angle_increment)) * rho_e * rho_n
-    thr = lam_step * np.maximum(rho_e, rho_n) + params.gap_floor
+    thr = join_threshold(np.maximum(rho_e, rho_n), angle_increment, params)  # Eq. 3
     codes = np.zeros(beams.shape, dtype=np.int64)
-    codes[has & (rho_n < rho_e - (lam_step * rho_e + params.gap_floor))] = EDGE_OCCLUDED
+    nearer = rho_n < rho_e - join_threshold(rho_e, angle_increment, params)
+    codes[has & nearer] = EDGE_OCCLUDED
     codes[outside | (has & (rho_n > params.window_radius) & (d2 <= thr * thr))] = EDGE_CLIPPED
     return codes

@@ -34,16 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.perception.clustering import grid_index
 from zenav.services.planner.prediction import gap_to_boxes, path_points
 
 Vec = npt.NDArray[np.float64]
 
 SAMPLES_PER_CELL = 20
-
-
-def grid_cell(point: Vec, cell: float) -> tuple[int, int]:
-    """Eq. 2: the grid coordinates of a point."""
-    return (math.floor(point[0] / cell + 0.5), math.floor(point[1] / cell + 0.5))
 
 
 def cells_on_segment(a: Vec, b: Vec, cell: float) -> set[tuple[int, int]]:
@@ -52,8 +48,13 @@ def cells_on_segment(a: Vec, b: Vec, cell: float) -> set[tuple[int, int]]:
     count = max(2, math.ceil(length * SAMPLES_PER_CELL / cell) + 1)
     t = np.linspace(0.0, 1.0, count)[:, None]
     points = a[None, :] + t * (b - a)[None, :]
-    index = np.floor(points / cell + 0.5).astype(np.int64)
+    index = grid_index(points, cell)
     return {(int(i), int(j)) for i, j in np.unique(index, axis=0)}
+
+
+def shared_term(shared_cells: int) -> float:
+    """Eq. 17's W = 1 / (1 + m), m the grid cells a candidate shares with the global path."""
+    return 1.0 / (1 + shared_cells)
 
 
 def morphin_cost(
@@ -155,7 +156,7 @@ def choose_detour(
         points = path_points(robot, direction, length, cell / 4)
         times = np.linspace(0.0, length / speed if speed > 0 else math.inf, len(points))
         shared = len(cells_on_segment(robot, end, cell) & global_cells)
-        w = 1.0 / (1 + shared)
+        w = shared_term(shared)
         delta_l = (to_goal(end) if to_goal is not None else float(np.hypot(*(goal - end)))) / cell
         blocked = _blocked(points, times, boxes, movers, robot_radius, margin)
         cost = math.inf if blocked else morphin_cost(g, delta_l, w, kappa)

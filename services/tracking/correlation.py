@@ -34,6 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.services.geometry import wrap_degrees
+from zenav.services.perception.clustering import box_area
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -135,16 +136,14 @@ def correlate(
     bp = np.asarray(box_prev, dtype=np.int64).reshape(-1, 4)
     cc = np.asarray(centre_cur, dtype=np.float64).reshape(-1, 2)
     cp = np.asarray(centre_prev, dtype=np.float64).reshape(-1, 2)
-    area_c = (bc[:, 1] - bc[:, 0] + 1) * (bc[:, 3] - bc[:, 2] + 1)  # Eq. 6
-    area_p = (bp[:, 1] - bp[:, 0] + 1) * (bp[:, 3] - bp[:, 2] + 1)
+    area_c = box_area(bc)[:, None]  # Eq. 6
+    area_p = box_area(bp)[None, :]
     inter = overlap_cells(bc[:, None, :], bp[None, :, :])  # Eqs. 7-9
-    union = area_c[:, None] + area_p[None, :] - inter  # Eq. 10
-    xi = inter / area_c[:, None].astype(np.float64)  # Eq. 11
-    eta = 1.0 - inter / union.astype(np.float64)  # Eq. 13
-    dx = cc[:, None, 0] - cp[None, :, 0]
-    dy = cc[:, None, 1] - cp[None, :, 1]
-    delta = np.sqrt(dx * dx + dy * dy) / cell  # Eq. 13, cells
-    varsigma = y_delta / (delta + 1.0) + y_eta / (eta + 1.0)  # Eq. 12
+    union = union_cells(area_c, area_p, inter)  # Eq. 10
+    xi = coincidence(inter, area_c)  # Eq. 11
+    eta = non_overlap_rate(inter, union)  # Eq. 13
+    delta = centre_distance(cc[:, None, :], cp[None, :, :], cell)  # Eq. 13, cells
+    varsigma = spatial_correlation(delta, eta, y_delta, y_eta)  # Eq. 12
     return Correlation(inter=inter, union=union, xi=xi, eta=eta, delta=delta, varsigma=varsigma)
 
 

@@ -45,7 +45,13 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
-from zenav.services.perception.clustering import EDGE_FREE, EDGE_OCCLUDED, Clusters, box_area
+from zenav.services.perception.clustering import (
+    EDGE_FREE,
+    EDGE_OCCLUDED,
+    Clusters,
+    box_area,
+    to_global,
+)
 from zenav.services.tracking.correlation import (
     Kind,
     alpha_o_from_heading,
@@ -475,8 +481,8 @@ class Tracker:
         # Eq. 5 over all beams of the pieces (beam-weighted means), then Eq. 1.
         rho = float(np.dot(w, clusters.mean_rho[idx]) / w.sum())
         alpha = float(np.dot(w, clusters.mean_alpha[idx]) / w.sum())
-        heading = pose[2] + alpha
-        centre = (pose[0] + rho * math.cos(heading), pose[1] + rho * math.sin(heading))
+        gx, gy = to_global(pose, rho, alpha)
+        centre = (float(gx), float(gy))
         first, last = cl[0], cl[-1]
         cx = 0.5 * float(clusters.first_point[first, 0] + clusters.last_point[last, 0])
         cy = 0.5 * float(clusters.first_point[first, 1] + clusters.last_point[last, 1])
@@ -489,7 +495,7 @@ class Tracker:
             point=(cx, cy) if use_chord else centre,
             radius=radius,
             box=box,
-            area=(box[1] - box[0] + 1) * (box[3] - box[2] + 1),
+            area=int(box_area(np.array(box))),  # Eq. 6
             partial=bool(
                 clusters.edge_start[first] != EDGE_FREE or clusters.edge_end[last] != EDGE_FREE
             ),

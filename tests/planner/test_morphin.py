@@ -11,17 +11,11 @@ from zenav.services.planner.morphin import (
     Mover,
     cells_on_segment,
     choose_detour,
-    grid_cell,
     morphin_cost,
 )
 
 KAPPA = (1.0, 1.3, 0.6)
 NO_BOXES = (np.zeros((0, 2)), np.zeros((0, 2)))
-
-
-def test_grid_cell_rounds_to_the_nearest_multiple_of_the_resolution():  # Eq. 2
-    assert grid_cell(np.array([0.24, 0.26]), 0.5) == (0, 1)
-    assert grid_cell(np.array([-0.26, 1.74]), 0.5) == (-1, 3)
 
 
 def test_cells_on_a_horizontal_segment():
