@@ -1,0 +1,331 @@
+"""Each of the paper's equations (1-15, 17) pinned twice: to numbers worked by hand, and to
+the production path, which must call the very function pinned (a spy counts the calls; a
+copy of the equation inlined elsewhere would leave the count at zero and fail here).
+
+The production paths are the ones the services run: ``Perceiver.process`` (perception's
+node), ``Tracker.update`` (tracking's node) and ``Planner.step`` (the planner's node).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import pytest
+
+from zenav.schemas.messages import LaserScan
+from zenav.services.perception import clustering
+from zenav.services.perception.params import PerceptionParams
+from zenav.services.perception.perceive import Perceiver
+from zenav.services.planner import decide, morphin
+from zenav.services.planner.params import Params as PlannerParams
+from zenav.services.planner.prediction import Obstacle
+from zenav.services.tracking import correlation, tracker
+from zenav.services.tracking.params import TrackingParams
+
+HALF_DEG = math.radians(0.5)
+PAPER = PerceptionParams(gap_floor=0.0, min_beams=1, edge_inset=0.0)
+
+
+class Spy:
+    """Wraps ``module.name`` so that calls through the module are counted."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch, module: ModuleType, name: str) -> None:
+        self.calls = 0
+        real: Callable[..., Any] = getattr(module, name)
+
+        def counted(*args: Any, **kwargs: Any) -> Any:
+            self.calls += 1
+            return real(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, counted)
+
+
+# --- production paths ---------------------------------------------------------------
+
+
+def perceive(ranges: list[float], pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+             params: PerceptionParams = PAPER, stamp: float = 0.0,
+             perceiver: Perceiver | None = None) -> clustering.Clusters:
+    """One scan through perception's own path (what its node calls per scan)."""
+    # no return is range_max on the wire (a reading >= range_max counts as none)
+    r = np.minimum(np.asarray(ranges, dtype=np.float32), np.float32(8.0))
+    scan = LaserScan(stamp=stamp, seq=0, frame="laser", angle_min=0.0,
+                     angle_max=HALF_DEG * (len(r) - 1), angle_increment=HALF_DEG,
+                     range_min=0.05, range_max=8.0, ranges=r)
+    return (perceiver or Perceiver(params)).process(scan, pose)
+
+
+def track_two_frames(method: str = "paper") -> list[tracker.Track]:
+    """Two frames of one obstacle that moved 0.5 m, through the tracker's update."""
+    p = PerceptionParams()
+    perceiver = Perceiver(p)
+    track = tracker.Tracker(TrackingParams(method=method))  # type: ignore[arg-type]
+    out: list[tracker.Track] = []
+    for i, rho in enumerate((2.0, 2.5)):
+        ranges = [math.inf] * 40
+        for b in range(10, 30):
+            ranges[b] = rho
+        clusters = perceive(ranges, stamp=i * 0.5, params=p, perceiver=perceiver)
+        out = track.update(i * 0.5, (0.0, 0.0, 0.0), clusters)
+    return out
+
+
+def plan_round_a_box() -> decide.Decision:
+    """The planner meeting a standing box on its way (scenario (b): Morphin, Eq. 17)."""
+    planner = decide.Planner(PlannerParams(goal=(6.0, 0.0), start=(0.0, 0.0), confirm_time=0.0))
+    box = Obstacle(id=1, kind="static", position=(2.0, 0.0), velocity=(0.0, 0.0), radius=0.3,
+                   cells=(4, 4, 0, 0))
+    return planner.step((0.0, 0.0, 0.0), [box], stamp=1.0)
+
+
+# --- Eq. 1 --------------------------------------------------------------------------
+
+
+def test_eq1_by_hand() -> None:
+    # Robot at (1, 2) facing +y; a beam straight ahead (alpha 0) at 2 m ends at (1, 4);
+    # the beam 90 degrees to the right (alpha -pi/2, the paper's 0 degrees) at (3, 2).
+    x, y = clustering.to_global((1.0, 2.0, math.pi / 2), [2.0, 2.0], [0.0, -math.pi / 2])
+    assert np.allclose(x, [1.0, 3.0]) and np.allclose(y, [4.0, 2.0])
+
+
+def test_eq1_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    spy = Spy(monkeypatch, clustering, "to_global")
+    perceive([2.0, 2.0, 2.0])
+    assert spy.calls >= 2  # the points, then the Eq. 5 centres
+
+
+def test_eq1_is_what_tracking_calls_to_join_pieces(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tracker's centre of an obstacle in two pieces goes through Eq. 1 too."""
+    spy = Spy(monkeypatch, tracker, "to_global")
+    t = tracker.Tracker(TrackingParams())
+    m = t._measure([0, 1], _two_pieces(), (0.0, 0.0, 0.0), False)
+    assert spy.calls == 1
+    # beam-weighted mean rho (2*2 + 2*3) / 4 = 2.5 and alpha (2*0 + 2*0.1) / 4 = 0.05
+    assert m.centre == pytest.approx((2.5 * math.cos(0.05), 2.5 * math.sin(0.05)))
+
+
+def _two_pieces() -> clustering.Clusters:
+    f = np.array
+    return clustering.Clusters(
+        centre=f([[2.0, 0.0], [3.0, 0.3]]), mean_rho=f([2.0, 3.0]), mean_alpha=f([0.0, 0.1]),
+        box=f([[4, 4, 0, 0], [6, 6, 1, 1]]), area=f([1, 1]), beams=f([[0, 1], [2, 3]]),
+        n_beams=f([2, 2]), first_point=f([[2.0, 0.0], [3.0, 0.3]]),
+        last_point=f([[2.0, 0.0], [3.0, 0.3]]), chord_centre=f([[2.0, 0.0], [3.0, 0.3]]),
+        radius=f([0.1, 0.1]), edge_start=f([0, 0]), edge_end=f([0, 0]),
+        pose=(0.0, 0.0, 0.0), cell=0.5)
+
+
+# --- Eq. 2 --------------------------------------------------------------------------
+
+
+def test_eq2_by_hand() -> None:
+    # floor(x / 0.5 + 1/2): 0.24 -> floor(0.98) = 0, 0.26 -> floor(1.02) = 1,
+    # -0.26 -> floor(-0.02) = -1, 1.74 -> floor(3.98) = 3
+    assert clustering.grid_index([0.24, 0.26, -0.26, 1.74], 0.5).tolist() == [0, 1, -1, 3]
+
+
+def test_eq2_is_what_perception_and_morphin_call(monkeypatch: pytest.MonkeyPatch) -> None:
+    in_perception = Spy(monkeypatch, clustering, "grid_index")
+    in_morphin = Spy(monkeypatch, morphin, "grid_index")
+    perceive([2.0, 2.0, 2.0])
+    plan_round_a_box()
+    assert in_perception.calls >= 1 and in_morphin.calls >= 1
+
+
+# --- Eq. 3 --------------------------------------------------------------------------
+
+
+def test_eq3_by_hand() -> None:
+    # theta = 1.2 * 2 m * sin(0.5 deg) = 2.4 * 0.0087265 = 0.0209437 m; the floor adds 0.15
+    assert float(clustering.join_threshold(2.0, HALF_DEG, PAPER)) == pytest.approx(0.0209437,
+                                                                                   abs=1e-7)
+    floored = PerceptionParams()
+    assert float(clustering.join_threshold(2.0, HALF_DEG, floored)) == pytest.approx(0.1709437,
+                                                                                     abs=1e-7)
+
+
+def test_eq3_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    spy = Spy(monkeypatch, clustering, "join_threshold")
+    perceive([2.0, 2.0, 2.0])
+    assert spy.calls >= 1
+
+
+def test_eq3_decides_the_breaks(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A threshold of zero everywhere splits every beam: the one function decides."""
+    monkeypatch.setattr(clustering, "join_threshold",
+                        lambda rho, inc, params: np.zeros_like(np.asarray(rho, dtype=float)))
+    assert len(perceive([2.0, 2.0, 2.0])) == 3
+
+
+# --- Eq. 4 and Eq. 5: a worked obstacle chain ------------------------------------------
+
+
+def test_eq4_worked_obstacle_chain() -> None:
+    """Seven beams at 0, 0.5, ..., 3 degrees (robot at the origin facing +x), window 4 m:
+
+    ranges 2, 2, 2, none, 3, 3, 6.
+
+    * beams 0-2: neighbours 2 * 2 sin(0.25 deg) = 0.01745 m apart, under
+      theta = 1.2 * 2 * sin(0.5 deg) = 0.02094 m (Eq. 3): one cluster O_1;
+    * beam 3 has no return and is skipped: beam 2 is compared with beam 4, about 1 m
+      apart, over theta = 1.2 * 3 * sin(0.5 deg) = 0.03142: a new cluster O_2;
+    * beams 4-5: 3 * 2 sin(0.25 deg) = 0.02618 < 0.03142: both in O_2;
+    * beam 6 (6 m) lies outside r_w = 4 m and is not clustered.
+
+    O_chain(t) = {O_1, O_2} (Eq. 4). Eq. 5: O_1 has mean alpha 0.5 deg, mean rho 2, so
+    Z_1 = (2 cos 0.5, 2 sin 0.5) = (1.999924, 0.017453); O_2 has 2.25 deg and 3 m,
+    Z_2 = (2.997688, 0.117782). Eq. 2 / 6: O_1's points have x ~ 2.0, y in [0, 0.035]:
+    cells x 4, y 0, S_1 = 1; O_2's x ~ 2.997, y in [0.105, 0.131]: x 6, y 0, S_2 = 1.
+    """
+    chain = perceive([2.0, 2.0, 2.0, math.inf, 3.0, 3.0, 6.0])
+    assert len(chain) == 2
+    assert chain.beams.tolist() == [[0, 2], [4, 5]]
+    assert chain.n_beams.tolist() == [3, 2]
+    assert chain.mean_rho == pytest.approx([2.0, 3.0], abs=1e-6)
+    assert np.degrees(chain.mean_alpha) == pytest.approx([0.5, 2.25])
+    assert chain.centre == pytest.approx(np.array([[1.999924, 0.017453],
+                                                   [2.997688, 0.117782]]), abs=1e-5)
+    assert chain.box.tolist() == [[4, 4, 0, 0], [6, 6, 0, 0]]
+    assert chain.area.tolist() == [1, 1]
+
+
+def test_eq5_by_hand() -> None:
+    # runs [1, 2] and [3, 4] (alpha [0, 0.1] and [0.2, 0.3]): means 1.5, 3.5 and 0.05, 0.25
+    rho, alpha = clustering.cluster_means(np.array([1.0, 2.0, 3.0, 4.0]),
+                                          np.array([0.0, 0.1, 0.2, 0.3]),
+                                          np.array([0, 2]), np.array([2, 2]))
+    assert rho == pytest.approx([1.5, 3.5]) and alpha == pytest.approx([0.05, 0.25])
+
+
+def test_eq5_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    spy = Spy(monkeypatch, clustering, "cluster_means")
+    perceive([2.0, 2.0, 2.0])
+    assert spy.calls == 1
+
+
+# --- Eq. 6 --------------------------------------------------------------------------
+
+
+def test_eq6_by_hand() -> None:
+    # x 2..4 (3 cells) by y 1..1 (1 cell) = 3; x 0..1 by y 0..2 = 2 * 3 = 6
+    assert clustering.box_area([[2, 4, 1, 1], [0, 1, 0, 2]]).tolist() == [3, 6]
+
+
+def test_eq6_is_what_perception_and_tracking_call(monkeypatch: pytest.MonkeyPatch) -> None:
+    in_perception = Spy(monkeypatch, clustering, "box_area")
+    in_correlation = Spy(monkeypatch, correlation, "box_area")
+    track_two_frames()
+    assert in_perception.calls >= 1 and in_correlation.calls >= 1
+
+
+# --- Eqs. 7-13 ------------------------------------------------------------------------
+# S(t) = x 0..3, y 0..2 (12 cells); S(t-1) = x 2..5, y 1..4 (16 cells).
+A = (0, 3, 0, 2)
+B = (2, 5, 1, 4)
+
+
+def test_eqs7_to_9_by_hand() -> None:
+    # Eq. 9: sorted x bounds 0 2 3 5 -> x_b3 - x_b2 + 1 = 2; y bounds 0 1 2 4 -> 2; 4 cells
+    assert int(correlation.overlap_cells(A, B)) == 4
+    # Eq. 8: x_max(t-1) = 1 < x_min(t) = 3: no overlap
+    assert int(correlation.overlap_cells((3, 4, 0, 1), (0, 1, 0, 1))) == 0
+    # Eq. 7: the same box overlaps fully, S n S = S
+    assert int(correlation.overlap_cells(A, A)) == 12
+
+
+def test_eq10_and_11_by_hand() -> None:
+    assert int(correlation.union_cells(12, 16, 4)) == 24  # 12 + 16 - 4
+    assert float(correlation.coincidence(4, 12)) == pytest.approx(1 / 3)  # xi = 4 / 12
+
+
+def test_eq12_and_13_by_hand() -> None:
+    # eta = 1 - 4 / 24 = 0.833333; delta between (0, 0) and (0.3, 0.4) = 0.5 m = 1 cell
+    assert float(correlation.non_overlap_rate(4, 24)) == pytest.approx(5 / 6)
+    assert float(correlation.centre_distance((0.0, 0.0), (0.3, 0.4), 0.5)) == pytest.approx(1.0)
+    # varsigma = 0.5 / (1 + 1) + 0.5 / (0.5 + 1) = 0.25 + 0.333333 = 0.583333
+    assert float(correlation.spatial_correlation(1.0, 0.5)) == pytest.approx(0.5833333)
+
+
+def test_correlate_by_hand() -> None:
+    """The pair above through correlate: every quantity as worked out by hand."""
+    c = correlation.correlate([(0.0, 0.0)], [A], [(0.3, 0.4)], [B], cell=0.5)
+    assert (int(c.inter[0, 0]), int(c.union[0, 0])) == (4, 24)
+    assert float(c.xi[0, 0]) == pytest.approx(1 / 3)
+    assert float(c.eta[0, 0]) == pytest.approx(5 / 6)
+    assert float(c.delta[0, 0]) == pytest.approx(1.0)
+    # 0.5 / 2 + 0.5 / (1 + 5/6) = 0.25 + 0.272727 = 0.522727
+    assert float(c.varsigma[0, 0]) == pytest.approx(0.5227273)
+
+
+@pytest.mark.parametrize("name", ["overlap_cells", "union_cells", "coincidence",
+                                  "non_overlap_rate", "centre_distance",
+                                  "spatial_correlation"])
+def test_eqs7_to_13_are_what_tracking_calls(monkeypatch: pytest.MonkeyPatch, name: str) -> None:
+    spy = Spy(monkeypatch, correlation, name)
+    track_two_frames()
+    assert spy.calls >= 1
+
+
+# --- Eq. 14 and the decision tree ------------------------------------------------------
+
+
+def test_eq14_by_hand() -> None:
+    c = correlation.correlate([(0.0, 0.0)], [(0, 0, 0, 0)],
+                              [(5.0, 0.0), (0.0, 0.0), (0.5, 0.0)],
+                              [(10, 10, 0, 0), (0, 0, 0, 0), (1, 1, 0, 0)], cell=0.5)
+    # varsigma to each: 0.5/11 + 0.5/2 = 0.295455; 0.5 + 0.5 = 1; 0.5/2 + 0.5/2 = 0.5
+    assert c.varsigma[0] == pytest.approx([0.2954545, 1.0, 0.5])
+    best = correlation.best_match(c)
+    assert int(best.index[0]) == 1 and float(best.varsigma_max[0]) == pytest.approx(1.0)
+
+
+def test_eq14_and_the_tree_are_what_tracking_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    best = Spy(monkeypatch, tracker, "best_match")
+    tree = Spy(monkeypatch, tracker, "classify")
+    track_two_frames("paper")
+    assert best.calls == 2 and tree.calls == 2  # one per frame, one obstacle each
+
+
+def test_the_tree_decides_the_type_in_paper_mode(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(tracker, "classify", lambda *a, **k: "dynamic")
+    assert [t.kind for t in track_two_frames("paper")] == ["dynamic"]
+
+
+# --- Eq. 15 -------------------------------------------------------------------------
+
+
+def test_eq15_by_hand() -> None:
+    # from (0, 0) to (1, 1) in T = 0.5 s: d_o = sqrt 2 = 1.414214 m, v_o = 2.828427 m/s,
+    # alpha_o = arctan(dx / dy) = arctan(1) = 45 deg (clockwise from +y)
+    m = correlation.motion((1.0, 1.0), (0.0, 0.0), 0.5)
+    assert (m.d_o, m.v_o, m.alpha_o_deg) == pytest.approx((1.4142136, 2.8284271, 45.0))
+    assert correlation.motion((0.0, -1.0), (0.0, 0.0), 1.0).alpha_o_deg == pytest.approx(180.0)
+
+
+def test_eq15_is_what_tracking_calls_in_paper_mode(monkeypatch: pytest.MonkeyPatch) -> None:
+    spy = Spy(monkeypatch, tracker, "motion")
+    tracks = track_two_frames("paper")
+    assert spy.calls == 1  # the second frame against the first
+    # the obstacle's Eq. 5 centre moved from 2 m to 2.5 m ahead in 0.5 s: 1 m/s along +x
+    assert tracks[0].speed == pytest.approx(1.0, rel=0.02)
+
+
+# --- Eq. 17 -------------------------------------------------------------------------
+
+
+def test_eq17_by_hand() -> None:
+    # y = 1 * |0.2| + 1.3 * 3 + 0.6 * 0.25 = 0.2 + 3.9 + 0.15 = 4.25; W = 1 / (4 + 1) = 0.2
+    assert morphin.morphin_cost(-0.2, 3.0, 0.25, (1.0, 1.3, 0.6)) == pytest.approx(4.25)
+    assert morphin.shared_term(4) == pytest.approx(0.2)
+
+
+def test_eq17_is_what_the_planner_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    cost = Spy(monkeypatch, morphin, "morphin_cost")
+    w = Spy(monkeypatch, morphin, "shared_term")
+    decision = plan_round_a_box()
+    assert decision.action == "morphin" and decision.scenario == "b"
+    assert cost.calls >= 1 and w.calls >= 1
