@@ -143,7 +143,9 @@ class Clusters:
         )
 
 
-def to_global(pose: Pose, rho: npt.ArrayLike, alpha: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+def to_global(
+    pose: Pose, rho: npt.ArrayLike, alpha: npt.ArrayLike
+) -> tuple[FloatArray, FloatArray]:
     """Eq. 1: global (x, y) of the points at range ``rho`` and beam angle ``alpha``.
 
     ``alpha`` is counter-clockwise from the heading (see the module notes), so the paper's
