@@ -1,6 +1,7 @@
 """Parameters: code defaults, overridden by YAML files, overridden by ``--set``.
 
-Each value's origin is kept (:func:`resolve`): ``default`` (the code), ``scenario`` (what
+Each value's origin is kept (:func:`resolve`): ``default`` (the code), ``profile`` (a named
+set of overrides, :mod:`zenav.services.profiles`), ``scenario`` (what
 :func:`zenav.services.mission.stack_params` derives), ``file`` or ``--set``.
 
 Every service keeps all its parameters, with defaults and units, in one pydantic model.
@@ -85,7 +86,7 @@ def format_error(source: str, error: ErrorDetails) -> str:
     return f"{source}: {where}: {error['msg']}{got}"
 
 
-Origin = Literal["default", "scenario", "file", "--set"]
+Origin = Literal["default", "profile", "scenario", "file", "--set"]
 """Where a parameter's value came from, lowest precedence first."""
 
 
@@ -158,6 +159,7 @@ def show_settings(title: str, settings: list[Setting], width: int = 88) -> str:
         value = yaml.safe_dump(setting.value, default_flow_style=True).strip()
         value = value.removesuffix("...").strip()
         where = setting.origin if setting.origin in ("default", "--set") else (
+            setting.source if setting.origin == "profile" else
             f"{setting.origin} {setting.source.removeprefix('scenario ')}")
         lines.append(f"{setting.name}: {value}  # {where}")
     return "\n".join(lines)

@@ -26,6 +26,7 @@ class Job:
     scenario: Path
     out: Path
     planner: str = "paper"
+    profile: str = "zenav"  # the parameter profile (zenav.services.profiles)
 
     @property
     def name(self) -> str:
@@ -47,7 +48,7 @@ def run_job(job: Job, *, log_level: str = "INFO", reuse: bool = False,
         return reused
     try:
         record = run_scenario(job.scenario, job.out, planner=job.planner, log_level=log_level,
-                              picture=False)
+                              picture=False, profile=job.profile)
     except Exception as exc:
         if not keep_going:
             raise

@@ -19,10 +19,12 @@ def add_command(sub: Any) -> None:
     params = sub.add_parser(
         "params", help="print a service's parameters, their values and where they came from",
         description="Print every parameter of a service as YAML, each value followed by its "
-                    "origin: default, scenario, file or --set.")
+                    "origin: default, profile, scenario, file or --set.")
     params.add_argument("name", help=f"service: {', '.join(SERVICE_ORDER)}")
     params.add_argument("--planner", default="paper",
                         help="planner implementation, for NAME planner (default paper)")
+    params.add_argument("--profile", default="zenav", metavar="NAME",
+                        help="parameter profile laid over the defaults: zenav or paper")
     params.add_argument("--scenario", type=Path, metavar="FILE",
                         help="the values zenav run derives from this scenario")
     params.add_argument("--params", type=Path, action="append", default=[], metavar="FILE",
@@ -42,12 +44,13 @@ def run(args: argparse.Namespace) -> int:
         show_settings,
     )
     from zenav.services.mission import scenario_layer
+    from zenav.services.profiles import profile_layer
     from zenav.services.runner import service_params
     from zenav.sim.scenario import ScenarioError, load_scenario
 
     try:
         model = service_params(args.name, args.planner)
-        layers: list[Layer] = []
+        layers: list[Layer] = [profile_layer(args.profile, args.name, args.planner)]
         if args.scenario is not None:
             scenario = load_scenario(args.scenario)
             layers.append(scenario_layer(scenario, args.scenario, args.name, args.planner))

@@ -23,6 +23,7 @@ from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
 from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
 from zenav.services.mission import stack_params
+from zenav.services.profiles import DEFAULT_PROFILE, apply_profile
 from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
 from zenav.services.runner import PLANNERS
 from zenav.services.transport import ZenohBus
@@ -185,16 +186,20 @@ def run_scenario(
     picture: bool = True,
     robot_face: str = "native",
     mcap: bool = False,
+    profile: str = DEFAULT_PROFILE,
 ) -> dict[str, Any]:
     """Run one scenario through the full stack; write run.json and run.png; the record.
 
     ``robot_face="ros2"``: the simulated robot is a ROS 2 robot over rmw_zenoh, reached
     through the ros2 backends of the laser driver and motor bridge. ``mcap``: also
-    ``run.mcap``, every message of the run, openable in Foxglove."""
+    ``run.mcap``, every message of the run, openable in Foxglove. ``profile``: the named
+    set of parameter overrides (``zenav.services.profiles``) laid over the defaults,
+    under the scenario's values and ``overrides``."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
         raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
     params = stack_params(scenario, scenario_path, planner)
+    apply_profile(params, profile, planner)  # raises ConfigError for an unknown profile
     if robot_face not in ROBOT_FACES:
         raise ConfigError(f"--robot {robot_face!r}: choose one of {', '.join(ROBOT_FACES)}")
     if robot_face == "ros2":
@@ -213,6 +218,8 @@ def run_scenario(
     record = make_record(result, events, planner)
     record["wall_time"] = round(time.monotonic() - started, 3)
     record["seed"] = scenario.seed
+    if profile != DEFAULT_PROFILE:
+        record["profile"] = profile
     unclean = {name: code for name, code in codes.items() if code != 0}
     if unclean:
         record["unclean_exits"] = unclean

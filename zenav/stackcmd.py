@@ -21,7 +21,8 @@ def _run(args: argparse.Namespace) -> int:
     try:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level,
-                              robot_face=args.robot, mcap=args.record)
+                              robot_face=args.robot, mcap=args.record,
+                              profile=args.profile)
     except (ScenarioError, ConfigError) as exc:
         # one line, every problem in it: "file: field: problem; file: field: problem"
         print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
@@ -60,6 +61,9 @@ def add_commands(sub: Any) -> None:
     run.add_argument("scenario", type=Path, help="scenario YAML file")
     run.add_argument("--out", type=Path, required=True, help="directory for run.json, run.png")
     run.add_argument("--planner", default="paper", help="planner service (default paper)")
+    run.add_argument("--profile", default="zenav", metavar="NAME",
+                     help="parameter profile: zenav (the defaults) or paper (Section 3 as "
+                          "written); --set still overrides it")
     run.add_argument("--set", action="append", default=[], metavar="SERVICE.NAME=VALUE",
                      help="override a service parameter, e.g. perception.lambda_=1.5")
     run.add_argument("--log-level", default="INFO", help="services' log level")

@@ -74,6 +74,16 @@ class Detour:
     side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
 
 
+def first_in_scan_order(threats: list[Assessment], robot: Vec, heading: float) -> Assessment:
+    """The threat Algorithm 1 meets first: O_chain runs in scan order, the paper's 0 to
+    180 degrees, right to left; the threat at the smallest bearing from the robot's right
+    comes first."""
+    def bearing(a: Assessment) -> float:
+        dx, dy = a.obstacle.position[0] - robot[0], a.obstacle.position[1] - robot[1]
+        return math.remainder(math.atan2(dy, dx) - heading + math.pi / 2, math.tau)
+    return min(threats, key=lambda a: (bearing(a), a.obstacle.id))
+
+
 class Planner:
     """The paper's navigation decisions, one call per scan."""
 
@@ -88,6 +98,7 @@ class Planner:
         self.commitments: dict[int, Commitment] = {}  # obstacle id -> how it is answered
         self.first_seen: dict[int, float] = {}  # obstacle id -> stamp
         self.sides: dict[int, int] = {}  # obstacle id -> side it was last passed on
+        self.asked = params.cruise_speed  # V_R of Algorithm 1, for slow_step
         if self.start is not None:
             self.global_cells = cells_on_segment(self.start, self.goal, params.cell)
 
@@ -463,6 +474,8 @@ class Planner:
             seen = found.get(ob_id)
             base = seen if seen is not None else dataclasses.replace(held.last, obstacle=crosser)
             threats.append(dataclasses.replace(base, letter="e", threat=True))
+        if p.threats_per_cycle == "one" and threats:  # Algorithm 1: first in O_chain, break
+            threats = [first_in_scan_order(threats, robot, pose[2])]
         threat_ids = {a.obstacle.id for a in threats}
         self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}
 
@@ -476,7 +489,7 @@ class Planner:
             # speed (a head-on mover may leave no time to step aside slowly).
             fast = False
             detour = self.plan_detour(robot, lead, in_window, fast)
-            if detour is None and lead.letter == "f":
+            if detour is None and lead.letter == "f" and p.fast_fallback:
                 fast = True
                 detour = self.plan_detour(robot, lead, in_window, fast)
             if detour is None:
@@ -498,6 +511,9 @@ class Planner:
                 act, v = self.crossing_response(a, committed.action if committed else None)
             else:
                 act, v = self.follow_response(a)
+            if p.slow_step > 0.0:  # Algorithm 1: "avoidable" -> V_R = V_R - Delta V_R
+                v = max(self.asked - p.slow_step, 0.0)
+                act = "slow" if v > 0.0 else "stop"
             self.commitments[a.obstacle.id] = Commitment(a.letter, act, a)
             responses.append((v, act, a))
         if responses:
@@ -512,7 +528,7 @@ class Planner:
         movers = [o for o in in_window
                   if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
         offset = target - robot
-        if movers and float(np.hypot(*offset)) > 1e-9:
+        if p.speed_check and movers and float(np.hypot(*offset)) > 1e-9:
             direction = offset / float(np.hypot(*offset))
             safe, culprit = self.safe_speed(robot, direction, speed, movers)
             doomed = not math.isinf(self._first_contact(robot, direction * safe, movers)[0])
@@ -556,6 +572,7 @@ class Planner:
             letter = "a"
 
 
+        self.asked = speed
         tx, ty = float(target[0]), float(target[1])
         v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,
                                   p.heading_gain, p.max_omega)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.services.mission import CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
@@ -74,6 +76,27 @@ class Params(MissionParams):
     safety_horizon: float = Field(
         6.0, gt=0, description="how far ahead the speed check looks for a mover touching "
         "the robot, s"
+    )
+
+    # --- Algorithm 1 (the paper profile sets these to the paper's rules) -------------
+    threats_per_cycle: Literal["all", "one"] = Field(
+        "all", description="'all': beyond the paper, every threat in the window is answered "
+        "at once (the lowest speed any asks for, a detour round all). 'one': Algorithm 1, "
+        "the first threat in scan order (right to left) is answered and the rest wait for "
+        "a later cycle"
+    )
+    slow_step: float = Field(
+        0.0, ge=0, description="Delta V_R, m/s per cycle: > 0 answers (e) and (g) with "
+        "Algorithm 1's V_R - Delta V_R (back to V_R once no collision is predicted); 0: "
+        "beyond the paper, the speed that lets the crosser pass or keeps the gap behind"
+    )
+    speed_check: bool = Field(
+        True, description="beyond the paper: refuse a speed at which a seen mover would "
+        "touch the robot within safety_horizon, and step aside when no speed is safe"
+    )
+    fast_fallback: bool = Field(
+        True, description="beyond the paper: when no detour round a head-on mover (f) is "
+        "clear at V_R, plan one at max_speed"
     )
 
     # --- responses ------------------------------------------------------------------

@@ -51,11 +51,12 @@ class TrackingParams(BaseModel):
     compare_dt: float = Field(
         0.0,
         ge=0.0,
-        description="seconds: the chain the decision tree (and, in 'paper', Eq. 15) compares "
-        "with is "
-        "the newest one at least this old; 0 = the previous frame, the paper's t-1. At 10 Hz "
-        "a walker moves a tenth of a cell per frame, too little for the tree, so a longer "
-        "horizon can be tried here.",
+        description="T, seconds: the chain the decision tree (and, in 'paper', Eq. 15) "
+        "compares with is the newest one at least this old; 0 = the previous frame. The "
+        "paper never fixes T; at 10 Hz a walker moves a tenth of a cell per frame, too "
+        "little for the tree (theta_delta = 0.4 cells), so the paper profile compares with "
+        "the frame 0.5 s back (the typing accuracy against T is in "
+        "docs/tracking-accuracy.txt).",
     )
 
     # --- track keeping (both methods) ---

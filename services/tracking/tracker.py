@@ -72,6 +72,9 @@ _MERGE_GROWTH = 0.05
 _NO_MATCH = 1e9
 # A chip of an obstacle starts at most this many beams after it (see _adjacent_piece).
 _PIECE_BEAMS = 3
+# Stamps are sums of scan periods: 0.3 - 0.1 need not reach 0.2 exactly, so a chain counts
+# as compare_dt old within this much, seconds.
+_STAMP_SLACK = 1e-6
 
 
 @dataclass(frozen=True)
@@ -504,7 +507,7 @@ class Tracker:
 
     def _reference(self, stamp: float) -> tuple[float, FloatArray, IntArray]:
         """The chain to compare with: the newest at least ``compare_dt`` old, else the oldest."""
-        limit = stamp - self.params.compare_dt
+        limit = stamp - self.params.compare_dt + _STAMP_SLACK
         chosen: tuple[float, FloatArray, IntArray] | None = None
         for entry in self._history:
             if entry[0] <= limit:
@@ -518,7 +521,7 @@ class Tracker:
     def _remember(self, stamp: float, centres: FloatArray, boxes: IntArray) -> None:
         """Store this chain, dropping the ones no later frame can compare with."""
         self._history.append((stamp, centres, boxes))
-        limit = stamp - self.params.compare_dt
+        limit = stamp - self.params.compare_dt + _STAMP_SLACK
         # Keep the newest entry at or before the limit (the next frame's limit is later).
         while len(self._history) > 1 and self._history[1][0] <= limit:
             self._history.popleft()

@@ -1,4 +1,4 @@
-"""The accuracy benchmark runs, and the smoothed estimate meets the targets on a simple case."""
+"""The accuracy benchmark runs, and the zenav profile meets the targets on a simple case."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ def load_bench() -> ModuleType:
 
 def test_smoothed_estimate_meets_the_targets_at_noise_0_01() -> None:
     bench: Any = load_bench()
-    smoothed = [m for m in bench.methods() if m.name == "smoothed"]
+    smoothed = [m for m in bench.methods() if m.name == "zenav"]
     rows = bench.evaluate(
         noises=(0.01,),
         motions=("moving",),
@@ -36,5 +36,15 @@ def test_main_prints_the_table(capsys: pytest.CaptureFixture[str]) -> None:
     bench: Any = load_bench()
     assert bench.main(["--seeds", "1", "--duration", "1.5", "--no-per-mover"]) == 0
     out = capsys.readouterr().out
-    assert "smoothed" in out and "paper-1s" in out and ">=95%" in out
-    assert out.count("moving") >= 9  # 3 noises x 3 methods
+    assert "zenav" in out and "paper" in out and ">=95%" in out
+    assert out.count("moving") >= 6  # 3 noises x 2 profiles
+
+
+def test_the_table_against_t(capsys: pytest.CaptureFixture[str]) -> None:
+    bench: Any = load_bench()
+    assert bench.main(["--seeds", "1", "--duration", "1.5", "--compare-periods", "0.1,1"]) == 0
+    out = capsys.readouterr().out
+    assert "T=0.1s" in out and "T=1s" in out
+    assert out.count("moving") == 2  # noise 0.01 only, one row per T
+    with pytest.raises(SystemExit):
+        bench.main(["--compare-periods", "soon"])

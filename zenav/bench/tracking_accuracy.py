@@ -1,4 +1,4 @@
-"""Accuracy of obstacle typing and mover speed / heading: the paper's estimate vs the smoothed one.
+"""Accuracy of obstacle typing and mover speed / heading: the paper profile vs zenav's.
 
 Simulated scans (the simulator's pure modules: scenario, world, raycast) of a small scene seen
 from a robot that stands still or drives at full speed while turning. The scene has three
@@ -38,6 +38,7 @@ from zenav.services.geometry import wrap_angle
 from zenav.services.perception.clustering import cluster_scan
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
+from zenav.services.profiles import profile_values
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Track, Tracker
 from zenav.sim.raycast import cast_rays, simulate_scan
@@ -75,19 +76,30 @@ class Method:
     tracking: TrackingParams
 
 
-def methods() -> list[Method]:
-    """The paper's clustering and two-frame estimate, and this project's smoothed estimate.
+def profile_method(profile: str, compare_dt: float | None = None,
+                   name: str | None = None) -> Method:
+    """Perception and tracking as parameter profile ``profile`` sets them (the one place,
+    ``zenav.services.profiles``); ``compare_dt`` replaces its T."""
+    tracking = profile_values(profile, "tracking")
+    if compare_dt is not None:
+        tracking["compare_dt"] = compare_dt
+    return Method(name or profile, PerceptionParams(**profile_values(profile, "perception")),
+                  TrackingParams(**tracking))
 
-    "paper" compares each frame with the previous one (the paper's t-1, here 0.1 s);
-    "paper-1s" is the same with the chain of 1 s before (``compare_dt``), which gives the
-    decision tree a displacement of about a cell to see.
-    """
-    paper = PerceptionParams.paper()
-    return [
-        Method("paper", paper, TrackingParams(method="paper")),
-        Method("paper-1s", paper, TrackingParams(method="paper", compare_dt=1.0)),
-        Method("smoothed", PerceptionParams(), TrackingParams(method="smoothed")),
-    ]
+
+def methods() -> list[Method]:
+    """The two profiles: ``paper`` (Eq. 3 alone, the decision tree and Eq. 15 over the
+    profile's T) and ``zenav`` (the defaults: the motion cue and the smoothed estimate)."""
+    return [profile_method("paper"), profile_method("zenav")]
+
+
+def period_methods(periods: Sequence[float]) -> list[Method]:
+    """The paper profile with each T (``compare_dt``) in ``periods``, seconds."""
+    return [profile_method("paper", t, f"T={t:g}s") for t in periods]
+
+
+COMPARE_PERIODS = (0.1, 0.3, 0.5, 1.0, 1.5, 2.0)
+"""T, s: the periods the table of typing accuracy against T tries."""
 
 
 def scenario_for(speed: float, alpha_o_deg: float, noise: float, seed: int) -> Scenario:
@@ -358,10 +370,34 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=int, default=3, help="runs per mover and setting")
     parser.add_argument("--no-per-mover", action="store_true", help="skip the per-mover tables")
     parser.add_argument("--duration", type=float, default=6.0, help="seconds per run")
+    parser.add_argument("--compare-periods", metavar="T,T,...", type=_periods, default=None,
+                        help="instead: the paper profile's typing accuracy against T, the "
+                             "period between the frames it compares (noise 0.01 m), e.g. "
+                             + ",".join(f"{t:g}" for t in COMPARE_PERIODS))
+
+
+def _periods(text: str) -> tuple[float, ...]:
+    try:
+        periods = tuple(float(t) for t in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected seconds separated by commas, got {text!r}") from None
+    if not periods or any(not (t >= 0.0 and math.isfinite(t)) for t in periods):
+        raise argparse.ArgumentTypeError(f"periods must be finite and >= 0, got {text!r}")
+    return periods
 
 
 def report(args: argparse.Namespace) -> int:
-    """Print the accuracy table (and one per mover speed at noise 0.01 m)."""
+    """Print the accuracy table (and one per mover speed at noise 0.01 m), or with
+    ``--compare-periods`` the paper profile's accuracy against T."""
+    if args.compare_periods is not None:
+        print("The paper profile's typing accuracy and mover speed / heading errors against T,")
+        print("the period between the two frames the decision tree and Eq. 15 compare. Movers")
+        print(f"(m/s): {', '.join(f'{s:g}' for s, _ in PAPER_MOVERS)}; noise 0.01 m; "
+              f"{args.seeds} seed(s), {args.duration:g} s per run, 10 Hz, 361 beams.\n")
+        print(format_table(evaluate(noises=(0.01,), seeds=args.seeds, duration=args.duration,
+                                    method_list=period_methods(args.compare_periods))))
+        return 0
     print("Typing accuracy after each obstacle's first two frames; mover speed (relative) and")
     print("heading errors (degrees) once seen for 1 s: median, 95th percentile, share within")
     print(f"target. Movers (m/s): {', '.join(f'{s:g}' for s, _ in PAPER_MOVERS)}; "
@@ -391,7 +427,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def add_command(kinds: Any) -> None:
     """``zenav bench accuracy`` (``kinds``: the subcommands of ``zenav bench``)."""
     accuracy = kinds.add_parser("accuracy", help="obstacle typing, mover speed and heading "
-                                "errors on simulated scans (paper vs smoothed estimate)")
+                                "errors on simulated scans (paper vs zenav profile)")
     _add_arguments(accuracy)
     accuracy.set_defaults(func=report)
 
