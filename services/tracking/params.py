@@ -55,7 +55,7 @@ class TrackingParams(BaseModel):
         "compares with is the newest one at least this old; 0 = the previous frame. The "
         "paper never fixes T; at 10 Hz a walker moves a tenth of a cell per frame, too "
         "little for the tree (theta_delta = 0.4 cells), so the paper profile compares with "
-        "the frame 0.5 s back (the typing accuracy against T is in "
+        "the frame 1 s back (the typing accuracy against T is in "
         "docs/tracking-accuracy.txt).",
     )
 
