@@ -314,8 +314,9 @@ def machine_description() -> str:
 
 
 def main(out: Path, quick: bool = False, parallel: int = 2,
-         profiles: tuple[str, ...] = PROFILES) -> Path:
-    """Run the experiments with a progress bar, draw the figures, write the report."""
+         profiles: tuple[str, ...] = PROFILES, reuse: bool = False) -> Path:
+    """Run the experiments with a progress bar, draw the figures, write the report.
+    ``reuse``: a run whose ``run.json`` is already in ``out`` is not run again."""
     import time
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -331,7 +332,7 @@ def main(out: Path, quick: bool = False, parallel: int = 2,
             progress.update(task, advance=1, description=job.key)
 
         # keep_going: a run that fails is a result of the report, not the end of it
-        records = run_batch(jobs, parallel, done, keep_going=True)
+        records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse)
         progress.update(task, description="figures")
         make_figures(out, jobs, records)
         progress.update(task, advance=1, description="typing accuracy")
@@ -346,7 +347,8 @@ def _command(args: argparse.Namespace) -> int:
 
     profiles = PROFILES if args.profile == "both" else (args.profile,)
     try:
-        report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles)
+        report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
+                      reuse=args.reuse)
     except RunError as exc:
         print(f"zenav paper: {exc}", file=sys.stderr)
         return 1
@@ -363,4 +365,7 @@ def add_command(sub: Any) -> None:
     paper.add_argument("--profile", choices=("both", *PROFILES), default="both",
                        help="parameter profile(s) to run: both (default, side by side), "
                             "zenav or paper")
+    paper.add_argument("--reuse", action="store_true",
+                       help="take a run.json already under --out as that run's record "
+                            "(finish or redraw an interrupted report)")
     paper.set_defaults(func=_command)
