@@ -182,15 +182,17 @@ def join_threshold(
 
 
 def cluster_means(
-    rho: FloatArray, alpha: FloatArray, starts: IntArray, counts: IntArray
+    rho: npt.ArrayLike, alpha: npt.ArrayLike, starts: npt.ArrayLike, counts: npt.ArrayLike
 ) -> tuple[FloatArray, FloatArray]:
     """Eq. 5: mean rho and mean alpha of each cluster.
 
     The clusters are runs of ``rho`` / ``alpha`` (1-D, back to back) starting at ``starts``
     with ``counts`` points each.
     """
-    mean_rho = np.add.reduceat(rho, starts) / counts
-    mean_alpha = np.add.reduceat(alpha, starts) / counts
+    first = np.asarray(starts, dtype=np.int64)
+    n = np.asarray(counts, dtype=np.float64)
+    mean_rho = np.add.reduceat(np.asarray(rho, dtype=np.float64), first) / n
+    mean_alpha = np.add.reduceat(np.asarray(alpha, dtype=np.float64), first) / n
     return mean_rho, mean_alpha
 
 
