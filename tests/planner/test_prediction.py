@@ -124,14 +124,16 @@ def test_g_slower_ahead_the_same_way() -> None:
     assert a.pcp == pytest.approx((1.2, 0.0))
     assert (a.robot_time, a.obstacle_time) == pytest.approx((12.0, 12.0))
     assert a.along_speed == pytest.approx(0.05)
-    assert Planner(PARAMS).follow_response(a) == ("slow", pytest.approx(0.05))
+    action, speed = Planner(PARAMS).follow_response(a)
+    assert action == "slow" and speed == pytest.approx(0.05)
 
 
 def test_a_and_h_are_the_planners() -> None:
     """(a): nothing in the way, keep going at V_R. (h): the box of (b) and the crosser of
     (e) at once: a detour round the box at the speed the crosser allows (here a stop)."""
     clear = Planner(PARAMS).step((0.0, 0.0, 0.0), [], stamp=1.0)
-    assert (clear.scenario, clear.action, clear.speed) == ("a", "keep", pytest.approx(V_R))
+    assert (clear.scenario, clear.action) == ("a", "keep")
+    assert clear.speed == pytest.approx(V_R)
     both = Planner(PARAMS).step((0.0, 0.0, 0.0), [
         ob((2.0, 0.0), kind="static", cells=(4, 4, 0, 0), ob_id=1),
         ob((1.0, -2.0), (0.0, 0.2), ob_id=2)], stamp=1.0)

@@ -63,7 +63,7 @@ def track_two_frames(method: str = "paper") -> list[tracker.Track]:
     """Two frames of one obstacle that moved 0.5 m, through the tracker's update."""
     p = PerceptionParams()
     perceiver = Perceiver(p)
-    track = tracker.Tracker(TrackingParams(method=method))  # type: ignore[arg-type]
+    track = tracker.Tracker(TrackingParams(method=method))
     out: list[tracker.Track] = []
     for i, rho in enumerate((2.0, 2.5)):
         ranges = [math.inf] * 40

@@ -7,6 +7,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -43,7 +44,8 @@ def test_the_paper_profile_is_the_papers_rules() -> None:
 
 
 def test_apply_profile_keeps_the_scenarios_values_and_spares_baselines() -> None:
-    params = {"perception": {"cell": 0.25, "gap_floor": 0.3}, "planner": {"goal": [1, 2]}}
+    params: dict[str, dict[str, Any]] = {"perception": {"cell": 0.25, "gap_floor": 0.3},
+                                         "planner": {"goal": [1, 2]}}
     apply_profile(params, "paper", "vfh")
     assert params["perception"] == {"cell": 0.25, "gap_floor": 0.3, "min_beams": 1,
                                     "edge_inset": 0.0}
@@ -87,7 +89,7 @@ CROSSER = Obstacle(id=2, kind="dynamic", position=(1.0, -2.0), velocity=(0.0, 0.
 
 def planner(**changes: object) -> Planner:
     return Planner(Params(goal=(6.0, 0.0), start=(0.0, 0.0), confirm_time=0.0,
-                          **changes))  # type: ignore[arg-type]
+                          **changes))
 
 
 def test_all_threats_at_once_is_h() -> None:
