@@ -35,7 +35,7 @@ ScenarioLetter = Literal["a", "b", "c", "d", "e", "f", "g", "h"]
 Action = Literal["keep", "slow", "stop", "speed_up", "morphin", "resume", "goal", "safety_stop"]
 
 
-def _array_validator(dtype: str, ndim: int) -> Any:
+def _array_validator(dtype: str, ndim: int, width: int = 5) -> Any:
     def convert(value: object) -> npt.NDArray[Any]:
         if isinstance(value, (bytes, bytearray, memoryview)):
             raw = bytes(value)
@@ -51,11 +51,12 @@ def _array_validator(dtype: str, ndim: int) -> Any:
             raise ValueError(f"expected {dtype} bytes or an array, got {type(value).__name__}")
         if ndim == 2:
             if array.ndim == 1:
-                if array.size % 5:
-                    raise ValueError(f"size {array.size} is not a multiple of the row width 5")
-                array = array.reshape(-1, 5)
-            elif array.ndim != 2 or array.shape[1] != 5:
-                raise ValueError(f"expected rows of 5 values, got shape {array.shape}")
+                if array.size % width:
+                    raise ValueError(f"size {array.size} is not a multiple of the row width "
+                                     f"{width}")
+                array = array.reshape(-1, width)
+            elif array.ndim != 2 or array.shape[1] != width:
+                raise ValueError(f"expected rows of {width} values, got shape {array.shape}")
         elif array.ndim != 1:
             raise ValueError(f"expected a flat array, got shape {array.shape}")
         array.setflags(write=False)
@@ -88,6 +89,15 @@ Rows5Array = Annotated[
                     "description": "little-endian float64 rows [t, x, y, heading, speed], packed"}),
 ]
 """An (n, 5) float64 array, carried as raw bytes on the wire."""
+
+Rows3Array = Annotated[
+    npt.NDArray[np.float64],
+    BeforeValidator(_array_validator("<f8", 2, width=3)),
+    PlainSerializer(_array_bytes("<f8"), return_type=bytes),
+    WithJsonSchema({"type": "string", "contentEncoding": "binary",
+                    "description": "little-endian float64 rows [t, x, y], packed"}),
+]
+"""An (n, 3) float64 array, carried as raw bytes on the wire."""
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
@@ -323,6 +333,15 @@ class GroundTruth(Message):
     obstacles: list[ObstacleTruth] = Field(max_length=1000)
 
 
+class AgentPath(BaseModel):
+    """Where one agent (an obstacle with ``behavior: orca``) was at each simulator tick."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, arbitrary_types_allowed=True)
+
+    index: int = Field(ge=0, description="position in the scenario's obstacle list")
+    rows: Rows3Array = Field(description="[t s, x m, y m] at the trajectory's ticks")
+
+
 class RunResult(Message):
     """How a simulated run ended, published once by the simulator."""
 
@@ -336,6 +355,9 @@ class RunResult(Message):
     )
     collided_with: int | None = None
     trajectory: Rows5Array
+    agents: list[AgentPath] = Field(
+        default_factory=list, description="the agents' paths (scenarios with agents only)"
+    )
 
 
 # --- health --------------------------------------------------------------------------

@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from zenav.services.mission import LIVE_SERVICES, MAX_OMEGA
 from zenav.services.ros2.params import Ros2Params
+from zenav.sim.agents import CrowdParams
 
 
 class Params(BaseModel):
@@ -50,6 +51,10 @@ class Params(BaseModel):
         default_factory=Ros2Params,
         description="topics, frames and domain of the simulated ROS 2 robot (its node: "
         "zenav_sim_robot unless ros2.node_name says otherwise)")
+    crowd: CrowdParams = Field(
+        default_factory=CrowdParams,
+        description="ORCA settings of the scenario's agents (behavior: orca)",
+    )
 
     @model_validator(mode="after")
     def _stamped_for_lockstep(self) -> Params:

@@ -153,6 +153,10 @@ class ObstacleSpec(_Model):
 
     The centre at time t is ``center + velocity * (t - appear)`` while
     ``appear <= t < vanish``; outside that interval the obstacle does not exist.
+
+    With ``behavior: orca`` the disc is an agent: it starts at ``center``, walks to its
+    ``goals`` in order at up to ``preferred_speed`` (m/s) and avoids the other agents (and
+    the robot when ``sees_robot``) with ORCA; its path is made by the run (``sim/agents.py``).
     """
 
     shape: Literal["box", "disc"]
@@ -162,6 +166,10 @@ class ObstacleSpec(_Model):
     velocity: Point = (0.0, 0.0)  # m/s
     appear: Number = 0.0  # s
     vanish: Number | None = None  # s; None means never
+    behavior: Literal["orca"] | None = None  # "orca": an agent (the fields below)
+    goals: list[Point] | None = None  # m, visited in order; it stays at the last one
+    preferred_speed: Positive | None = None  # m/s, also its top speed
+    sees_robot: Annotated[bool, Field(strict=True)] = False  # False: CrowdNav's "invisible"
 
     @field_validator("velocity", mode="before")
     @classmethod
@@ -185,14 +193,39 @@ class ObstacleSpec(_Model):
             problems.append(
                 (("vanish",), f"must be > appear ({self.appear:g}) (got {self.vanish:g})")
             )
+        problems += self._agent_problems()
         if problems:
             raise _ProblemsError(problems)
         return self
 
+    def _agent_problems(self) -> list[tuple[Loc, str]]:
+        problems: list[tuple[Loc, str]] = []
+        if self.behavior == "orca":
+            if self.shape != "disc":
+                problems.append((("shape",), f"behavior orca needs shape disc (got {self.shape})"))
+            if not self.goals:
+                problems.append((("goals",), "behavior orca needs a non-empty list of goals"))
+            if self.preferred_speed is None:
+                problems.append((("preferred_speed",), "required for behavior orca"))
+            if "velocity" in self.model_fields_set:
+                problems.append((("velocity",), "not allowed with behavior orca (an agent's "
+                                 "velocity comes from ORCA)"))
+        else:
+            given = self.model_fields_set
+            for name in ("goals", "preferred_speed", "sees_robot"):
+                if name in given:
+                    problems.append(((name,), "only for behavior: orca"))
+        return problems
+
+    @property
+    def is_agent(self) -> bool:
+        """True for an ORCA agent (``behavior: orca``)."""
+        return self.behavior == "orca"
+
     @property
     def is_static(self) -> bool:
-        """True when the obstacle does not move."""
-        return self.velocity[0] == 0.0 and self.velocity[1] == 0.0
+        """True when the obstacle does not move (an agent always may)."""
+        return not self.is_agent and self.velocity[0] == 0.0 and self.velocity[1] == 0.0
 
     @property
     def vanish_time(self) -> float:
@@ -402,6 +435,11 @@ def _problems(errors: Iterable[Any]) -> list[tuple[str, str]]:
 def dump_scenario(scenario: Scenario, path: str | Path) -> Path:
     """Write ``scenario`` as a scenario YAML file that :func:`load_scenario` reads back."""
     data = scenario.model_dump(mode="json", exclude_none=True)
+    for obstacle in data.get("obstacles", []):
+        if obstacle.get("behavior") == "orca":
+            obstacle.pop("velocity", None)  # an agent's velocity comes from ORCA
+        else:
+            obstacle.pop("sees_robot", None)
     target = Path(path)
     target.write_text(yaml.safe_dump(data, sort_keys=False))
     return target

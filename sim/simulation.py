@@ -8,7 +8,15 @@ from typing import Literal
 
 import numpy as np
 
-from zenav.schemas.messages import GroundTruth, ObstacleTruth, Odometry, Pose2D, RunResult
+from zenav.schemas.messages import (
+    AgentPath,
+    GroundTruth,
+    ObstacleTruth,
+    Odometry,
+    Pose2D,
+    RunResult,
+)
+from zenav.sim.agents import Crowd, RobotMotion
 from zenav.sim.contact import clearance, first_contact
 from zenav.sim.kinematics import RobotState, step_robot
 from zenav.sim.params import Params
@@ -44,6 +52,10 @@ class Simulation:
         self.min_clearance = math.inf
         self.outcome: Literal["reached", "collision", "timeout"] | None = None
         self.collided_with: int | None = None
+        self.crowd = Crowd(scenario, params.crowd)
+        self.crowd.start(self._robot_motion(0.0, self.state, (0.0, 0.0)))
+        self.agent_rows: list[deque[tuple[float, float, float]]] = [
+            deque(maxlen=keep) for _ in self.crowd.ids]
         self._record(0.0)
 
     @property
@@ -54,7 +66,30 @@ class Simulation:
         return self.tick % self.ticks_per_scan == 0
 
     def snapshot(self) -> WorldSnapshot:
-        return self.world.snapshot(self.t)
+        return self.snapshot_at(self.t, self.crowd.positions_at(self.t))
+
+    def snapshot_at(self, t: float, agent_positions: np.ndarray) -> WorldSnapshot:
+        """The obstacles at ``t`` (s), the agents at ``agent_positions`` (m) among them."""
+        snap = self.world.snapshot(t)
+        if not self.crowd.count:
+            return snap
+        on = self.crowd.exists(t)
+        return WorldSnapshot(
+            t=t,
+            disc_centers=np.concatenate([snap.disc_centers, agent_positions[on]]),
+            disc_radii=np.concatenate([snap.disc_radii, self.crowd.radii[on]]),
+            disc_velocities=np.concatenate([snap.disc_velocities,
+                                            self.crowd.velocities[on]]),
+            disc_ids=np.concatenate([snap.disc_ids, self.crowd.ids[on]]),
+            box_mins=snap.box_mins, box_maxs=snap.box_maxs,
+            box_velocities=snap.box_velocities, box_ids=snap.box_ids,
+        )
+
+    def _robot_motion(self, t0: float, state: RobotState,
+                      velocity: tuple[float, float]) -> RobotMotion:
+        robot = self.scenario.robot
+        return RobotMotion(t0=t0, position=(state.x, state.y), velocity=velocity,
+                           radius=robot.radius, max_speed=robot.effective_max_speed)
 
     def scan(self) -> np.ndarray:
         laser = self.scenario.laser
@@ -68,10 +103,13 @@ class Simulation:
             self.rng,
         )
 
-    def _record(self, t: float) -> None:
+    def _record(self, t: float, agent_positions: np.ndarray | None = None) -> None:
         s = self.state
         self.rows.append((t, s.x, s.y, s.heading, s.v))
-        gap = clearance((s.x, s.y), self.scenario.robot.radius, self.world.snapshot(t))
+        agents = self.crowd.positions_at(t) if agent_positions is None else agent_positions
+        for rows, (x, y) in zip(self.agent_rows, agents, strict=True):
+            rows.append((t, float(x), float(y)))
+        gap = clearance((s.x, s.y), self.scenario.robot.radius, self.snapshot_at(t, agents))
         self.min_clearance = min(self.min_clearance, gap)
 
     def step(self, v: float, omega: float) -> None:
@@ -94,6 +132,19 @@ class Simulation:
         t1 = round((self.tick + 1) * self.dt, 9)
         p0, p1 = (before.x, before.y), (after.x, after.y)
         contact = first_contact(p0, p1, robot.radius, self.world, t0, t1)
+        agents_at_hit: np.ndarray | None = None
+        if self.crowd.count:
+            # Agents move on straight lines between ORCA steps: check each piece.
+            u = ((p1[0] - p0[0]) / (t1 - t0), (p1[1] - p0[1]) / (t1 - t0))
+            motion = self._robot_motion(t0, before, u)
+            pieces = self.crowd.advance(t1, motion)
+            for ta, tb, piece in pieces:
+                hit = first_contact(motion.at(ta), motion.at(tb), robot.radius, piece, ta, tb)
+                if hit is not None and (contact is None or hit < contact):
+                    contact = hit
+            if contact is not None:  # where the agents were at the contact
+                piece = next(w for ta, tb, w in pieces if ta <= contact[0] <= tb + 1e-12)
+                agents_at_hit = piece.disc_centers_at(contact[0])
         if contact is not None:
             t_hit, index = contact
             frac = (t_hit - t0) / (t1 - t0) if t1 > t0 else 0.0
@@ -106,7 +157,7 @@ class Simulation:
             )
             self.path_length += frac * math.dist(p0, p1)
             self.tick += 1
-            self._record(t_hit)
+            self._record(t_hit, agents_at_hit)
             self.min_clearance = min(self.min_clearance, 0.0)
             self.outcome, self.collided_with = "collision", index
             return
@@ -157,4 +208,6 @@ class Simulation:
             min_clearance=self.min_clearance,
             collided_with=self.collided_with,
             trajectory=np.asarray(self.rows, dtype=np.float64),
+            agents=[AgentPath(index=int(i), rows=np.asarray(rows, dtype=np.float64))
+                    for i, rows in zip(self.crowd.ids, self.agent_rows, strict=True)],
         )

@@ -105,7 +105,9 @@ class World:
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> World:
         """Build the arrays from a validated scenario."""
-        discs = [(i, o) for i, o in enumerate(scenario.obstacles) if o.shape == "disc"]
+        # Agents (behavior: orca) move by ORCA, not on a fixed line: sim/agents.py.
+        discs = [(i, o) for i, o in enumerate(scenario.obstacles)
+                 if o.shape == "disc" and not o.is_agent]
         boxes = [(i, o) for i, o in enumerate(scenario.obstacles) if o.shape == "box"]
         n, k = len(discs), len(boxes)
         return cls(

@@ -53,7 +53,7 @@ def _finite_or_none(value: float) -> float | None:
 def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> dict[str, Any]:
     """The run record of the spec (``run.json``), from the simulator's result."""
     trajectory = [[round(float(v), 6) for v in row] for row in result.trajectory]
-    return {
+    record: dict[str, Any] = {
         "scenario": result.scenario,
         "planner": planner,
         "outcome": result.outcome,
@@ -69,6 +69,12 @@ def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> 
             if e.stamp <= result.time + 1e-9
         ],
     }
+    if result.agents:  # the spec's optional field: only for scenarios with agents
+        record["agents"] = {
+            str(a.index): [[round(float(v), 6) for v in row] for row in a.rows]
+            for a in result.agents
+        }
+    return record
 
 
 async def _collect(stack: Stack, progress_timeout: float,
