@@ -87,13 +87,18 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path) -> None:
         fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
         _world(ax, scenario, "0.92", max_cells=60)
         end = float(record["time"])
+        agent_paths = record.get("agents", {})  # ORCA agents: their paths come from the run
         for index, ob in enumerate(scenario.obstacles):
-            moving = ob.velocity is not None and any(ob.velocity)
+            moving = ob.is_agent or (ob.velocity is not None and any(ob.velocity))
             colour = MOVER_COLOUR if moving else STATIC_COLOUR
             t_show = max(ob.appear, min(end, ob.vanish_time - 1e-6))
             cx, cy = ob.center_at(t_show) if moving else ob.center
+            rows = agent_paths.get(str(index))
+            if rows:
+                ax.plot([r[1] for r in rows], [r[2] for r in rows], ls=":", color=colour, lw=1)
+                cx, cy = rows[-1][1], rows[-1][2]
             draw_obstacle(ax, ob, (cx, cy), colour, alpha=0.7)
-            if moving:
+            if moving and not rows:
                 x0, y0 = ob.center
                 ax.plot([x0, cx], [y0, cy], ls=":", color=colour, lw=1)
             ax.annotate(str(index), (cx, cy), ha="center", va="center", fontsize=7,
