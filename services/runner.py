@@ -52,6 +52,8 @@ PLANNERS: dict[str, Where] = {
                  "zenav.services.baselines.node:DWAService"),
     "apf": Where("zenav.services.baselines.params:APFParams",
                  "zenav.services.baselines.node:APFService"),
+    "orca": Where("zenav.services.baselines.params:ORCAParams",
+                  "zenav.services.baselines.node:ORCAService"),
 }
 """Planner implementations: each reads the same inputs and publishes the same outputs
 as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""

@@ -89,7 +89,7 @@ class Crowd:
     """The agents of a scenario, moved by ORCA; positions kept at time :attr:`t`."""
 
     def __init__(self, scenario: Scenario, params: CrowdParams | None = None) -> None:
-        self.params = p = params or CrowdParams()
+        self.params = params or CrowdParams()
         agents = [(i, o) for i, o in enumerate(scenario.obstacles) if o.is_agent]
         self.ids = np.array([i for i, _ in agents], dtype=np.int64)
         n = len(agents)

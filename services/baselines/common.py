@@ -43,6 +43,7 @@ class Cycle:
     goal: tuple[float, float]  # m
     movers: Obstacles = field(default_factory=Obstacles)  # tracks that move
     remembered: Obstacles = field(default_factory=Obstacles)  # standing tracks out of view
+    tracked: Obstacles = field(default_factory=Obstacles)  # every track (moving or not)
 
 
 def returns(cycle: Cycle, reach: float) -> BoolArray:

@@ -1,6 +1,7 @@
-"""The baseline planners as the ``planner`` service (``zenav run --planner vfh|dwa|apf``,
-``zenav service planner --planner vfh|dwa|apf``): the same inputs and outputs as the
-paper's planner. Algorithms: ``vfh.py``, ``dwa.py``, ``apf.py``; parameters: ``params.py``.
+"""The baseline planners as the ``planner`` service (``zenav run --planner
+vfh|dwa|apf|orca``, ``zenav service planner --planner ...``): the same inputs and outputs
+as the paper's planner. Algorithms: ``vfh.py``, ``dwa.py``, ``apf.py``, ``orca.py``;
+parameters: ``params.py``.
 
 It answers each track list with one velocity command stamped with the tracks' stamp
 (lockstep depends on it) and answers a repeated stamp by repeating its command. The
@@ -31,7 +32,8 @@ from zenav.schemas.messages import (
 from zenav.services.baselines.apf import APF
 from zenav.services.baselines.common import Cycle, Obstacles, goal_reached
 from zenav.services.baselines.dwa import DWA
-from zenav.services.baselines.params import APFParams, DWAParams, VFHParams
+from zenav.services.baselines.orca import ORCA
+from zenav.services.baselines.params import APFParams, DWAParams, ORCAParams, VFHParams
 from zenav.services.baselines.vfh import VFH
 from zenav.services.node import Node, StampGate
 from zenav.services.planner.params import MissionParams
@@ -116,7 +118,7 @@ class BaselineService:
         return Cycle(ranges=scan.ranges.astype(np.float64), angles=scan.angles(),
                      range_max=scan.range_max, pose=(pose.x, pose.y, pose.heading),
                      velocity=velocity, goal=p.goal,
-                     movers=movers, remembered=remembered)
+                     movers=movers, remembered=remembered, tracked=_obstacles(tracks.tracks))
 
     def on_tracks(self, tracks: TrackList) -> None:
         if not self.gate.admit(tracks.stamp, self.commands):
@@ -160,3 +162,8 @@ class DWAService(BaselineService):
 class APFService(BaselineService):
     def __init__(self, node: Node, params: APFParams) -> None:
         super().__init__(node, params, APF(params))
+
+
+class ORCAService(BaselineService):
+    def __init__(self, node: Node, params: ORCAParams) -> None:
+        super().__init__(node, params, ORCA(params))

@@ -10,7 +10,7 @@ from pydantic import Field, model_validator
 from zenav.services.mission import ACCEL, DECEL
 from zenav.services.planner.params import MissionParams
 
-__all__ = ["APFParams", "DWAParams", "VFHParams"]
+__all__ = ["APFParams", "DWAParams", "ORCAParams", "VFHParams"]
 
 
 class VFHParams(MissionParams):
@@ -105,3 +105,25 @@ class APFParams(MissionParams):
                                "than this belong to different obstacles, m")
     heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of angle to the "
                                 "force, 1/s")
+
+
+class ORCAParams(MissionParams):
+    """ORCA driving the robot (CrowdNav's baseline): CrowdNav's settings, and how the
+    holonomic answer becomes a unicycle command."""
+
+    time_step: float = Field(0.25, gt=0, description="ORCA's step: the velocity must be "
+                             "feasible over this time, s (CrowdNav: 0.25)")
+    neighbor_dist: float = Field(10.0, gt=0, description="obstacles farther than this are "
+                                 "ignored, m (CrowdNav: 10)")
+    max_neighbors: int = Field(10, gt=0, description="most obstacles considered (CrowdNav: 10)")
+    time_horizon: float = Field(5.0, gt=0, description="collision-free for this long, s "
+                                "(CrowdNav: 5)")
+    radius_margin: float = Field(0.01, ge=0, description="added to every radius, m "
+                                 "(CrowdNav: 0.01)")
+    slow_within: float = Field(1.0, gt=0, description="the preferred velocity is the vector "
+                               "to the goal divided by this, capped at the cruise speed, s "
+                               "(CrowdNav: 1)")
+    heading_gain: float = Field(2.0, gt=0, description="turn rate per rad of heading error, "
+                                "1/s")
+    max_drive_error: float = Field(math.pi / 2, gt=0, le=math.pi, description="heading error "
+                                   "above which the robot turns in place, rad")

@@ -58,10 +58,10 @@ def tracks(t: float, pose: Pose2D = POSE) -> TrackList:
 
 
 def test_the_baselines_are_planner_implementations():
-    assert {"vfh", "dwa", "apf"} <= set(PLANNERS)
+    assert {"vfh", "dwa", "apf", "orca"} <= set(PLANNERS)
 
 
-@pytest.mark.parametrize("name", ["vfh", "dwa", "apf"])
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf", "orca"])
 async def test_one_command_per_track_list_with_its_stamp_and_repeats_answered(name):
     async with planner(name, cruise_speed=0.2) as h:
         for t in (0.0, 0.1):
@@ -80,7 +80,7 @@ async def test_one_command_per_track_list_with_its_stamp_and_repeats_answered(na
     assert [s.action for s in states] == ["keep", "keep"]
 
 
-@pytest.mark.parametrize("name", ["vfh", "dwa", "apf"])
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf", "orca"])
 async def test_no_scan_yet_means_stop_and_the_goal_means_stop(name):
     async with planner(name) as h:
         h.send(keys.TRACKS, tracks(0.0))
