@@ -1,0 +1,79 @@
+"""bench crowd's columns from run records: CrowdNav's rates, time to goal, discomfort."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from zenav.bench_crowd import SETTINGS, check, discomfort_steps, summarise, table
+
+
+def record(planner: str, outcome: str, time: float, gaps: list[float]) -> dict:
+    """A robot standing at the origin; one human (radius 0.3) whose surface-to-surface gap
+    to the robot (radius 0.3) is ``gaps[i]`` at tick i."""
+    trajectory = [[0.1 * i, 0.0, 0.0, 0.0, 0.0] for i in range(len(gaps))]
+    human = [[0.1 * i, g + 0.6, 0.0] for i, g in enumerate(gaps)]
+    return {"scenario": "c", "planner": planner, "outcome": outcome, "time": time,
+            "trajectory": trajectory, "agents": {"0": human}}
+
+
+def test_discomfort_counts_ticks_within_point_two_metres_surface_to_surface():
+    assert discomfort_steps(record("p", "reached", 1.0, [1.0, 0.19, 0.05, 0.2, 0.5])) == (2, 5)
+
+
+def test_discomfort_takes_the_nearest_human():
+    r = record("p", "reached", 1.0, [1.0, 1.0, 1.0])
+    r["agents"]["3"] = [[0.1 * i, 0.0, 0.6 + g] for i, g in enumerate([1.0, 0.1, 1.0])]
+    assert discomfort_steps(r) == (1, 3)
+
+
+def test_rows_not_at_the_trajectory_ticks_are_refused():
+    r = record("p", "reached", 1.0, [1.0, 1.0, 1.0])
+    r["agents"]["0"] = r["agents"]["0"][:2]
+    with pytest.raises(ValueError, match="not at the trajectory's ticks"):
+        discomfort_steps(r)
+
+
+def test_summary_rates_time_of_the_successes_and_pooled_discomfort():
+    records = [
+        record("orca", "reached", 10.0, [1.0, 0.1, 1.0, 1.0]),
+        record("orca", "reached", 12.0, [1.0, 1.0, 1.0, 1.0]),
+        record("orca", "collision", 3.0, [0.1, 0.1, 0.1, 0.0]),
+        record("orca", "timeout", 25.0, [1.0, 1.0, 1.0, 1.0]),
+        {"scenario": "c", "planner": "orca", "outcome": "error", "error": "boom"},
+        record("paper", "reached", 14.0, [1.0, 1.0]),
+    ]
+    orca, paper = summarise(records, ["orca", "paper"])
+    assert (orca.runs, orca.errors) == (4, 1)
+    assert (orca.success, orca.collision, orca.timeout) == (0.5, 0.25, 0.25)
+    assert orca.time_to_goal == 11.0 and orca.discomfort == 5 / 16
+    assert (paper.runs, paper.success, paper.time_to_goal, paper.discomfort) == (1, 1.0, 14.0,
+                                                                                 0.0)
+    text = table([orca, paper])
+    assert "| orca | 4 (+1 failed) | 0.50 | 0.25 | 0.25 | 11.00 | 0.31 |" in text
+
+
+def test_a_planner_with_no_runs_shows_dashes():
+    (row,) = summarise([], ["dwa"])
+    assert row.runs == 0 and math.isnan(row.success)
+    assert "| dwa | 0 | — | — | — | — | — |" in table([row])
+
+
+def test_the_eight_settings():
+    assert list(SETTINGS) == [
+        "circle-invisible-180", "circle-invisible-360", "circle-visible-180",
+        "circle-visible-360", "square-invisible-180", "square-invisible-360",
+        "square-visible-180", "square-visible-360"]
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    ((["x"], ["circle-invisible-180"], 1, "stack", 1), "unknown planner x"),
+    ((["orca"], ["ring"], 1, "stack", 1), "unknown setting ring"),
+    ((["orca"], ["circle-invisible-180"], 0, "stack", 1), "--cases must be >= 1 (got 0)"),
+    ((["orca"], ["circle-invisible-180"], 1, "warp", 1), "unknown engine 'warp'"),
+    ((["orca"], ["circle-invisible-180"], 1, "stack", 0), "--jobs must be >= 1 (got 0)"),
+])
+def test_bad_arguments_are_one_line(args, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        check(*args)
