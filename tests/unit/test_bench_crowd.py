@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
 from zenav.bench_crowd import SETTINGS, check, discomfort_steps, summarise, table
 
 
-def record(planner: str, outcome: str, time: float, gaps: list[float]) -> dict:
+def record(planner: str, outcome: str, time: float, gaps: list[float]) -> dict[str, Any]:
     """A robot standing at the origin; one human (radius 0.3) whose surface-to-surface gap
     to the robot (radius 0.3) is ``gaps[i]`` at tick i."""
     trajectory = [[0.1 * i, 0.0, 0.0, 0.0, 0.0] for i in range(len(gaps))]
