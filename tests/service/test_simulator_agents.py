@@ -10,7 +10,7 @@ import numpy as np
 from tests.service.harness import running
 from zenav.schemas import keys
 from zenav.schemas.messages import GroundTruth, RunResult
-from zenav.sim.node import Params
+from zenav.sim.params import Params
 
 SCENARIO = """\
 name: one-walker

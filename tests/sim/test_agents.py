@@ -12,9 +12,10 @@ import pytest
 
 from zenav.schemas.codec import decode, encode
 from zenav.schemas.messages import RunResult
-from zenav.sim.node import Params, Simulation
+from zenav.sim.params import Params
 from zenav.sim.raycast import simulate_scan
 from zenav.sim.scenario import ScenarioError, dump_scenario, load_scenario, parse_scenario
+from zenav.sim.simulation import Simulation
 
 AGENT: dict[str, Any] = {"shape": "disc", "behavior": "orca", "center": [1.0, 5.0],
                          "radius": 0.3, "goals": [[9.0, 5.0]], "preferred_speed": 1.0}

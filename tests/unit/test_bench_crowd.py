@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from zenav.bench_crowd import SETTINGS, check, discomfort_steps, summarise, table
+from zenav.bench.crowd import SETTINGS, check, discomfort_steps, summarise, table
 
 
 def record(planner: str, outcome: str, time: float, gaps: list[float]) -> dict[str, Any]:
