@@ -31,7 +31,11 @@ from zenav.services.baselines.common import Cycle
 from zenav.services.baselines.params import ORCAParams
 from zenav.services.geometry import wrap_angle
 
-__all__ = ["ORCA", "Decision", "orca_velocity", "preferred_velocity", "unicycle_command"]
+__all__ = ["ORCA", "Decision", "Params", "orca_velocity", "preferred_velocity",
+           "unicycle_command"]
+
+Params = ORCAParams
+"""The parameters, as ``orca.Params`` like the other baselines' modules."""
 
 
 @dataclass(frozen=True)

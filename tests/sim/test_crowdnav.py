@@ -33,6 +33,7 @@ def test_the_robot_and_the_settings_are_crowdnavs_in_our_frame():
 def test_circle_humans_start_near_the_circle_and_head_for_the_opposite_point(case):
     sc = crowdnav_scenario("circle", case)
     for ob in sc.obstacles:
+        assert ob.goals is not None
         (sx, sy), (gx, gy) = ob.center, ob.goals[0]
         assert math.isclose(sx + gx, 12.0, abs_tol=1e-5) and math.isclose(sy + gy, 12.0,
                                                                           abs_tol=1e-5)
@@ -82,6 +83,7 @@ def test_the_rule_redraws_rather_than_skips():
 def test_square_humans_cross_from_one_half_of_the_square_to_the_other(case):
     sc = crowdnav_scenario("square", case)
     for ob in sc.obstacles:
+        assert ob.goals is not None
         (sx, sy), (gx, gy) = ob.center, ob.goals[0]
         assert (sx - 6.0) * (gx - 6.0) <= 0.0
         for v in (sx, sy, gx, gy):
