@@ -51,10 +51,23 @@ class Params(BaseModel):
         default_factory=Ros2Params,
         description="topics, frames and domain of the simulated ROS 2 robot (its node: "
         "zenav_sim_robot unless ros2.node_name says otherwise)")
-    crowd: CrowdParams = Field(
-        default_factory=CrowdParams,
-        description="ORCA settings of the scenario's agents (behavior: orca)",
-    )
+
+    # --- the agents (behavior: orca), CrowdNav's ORCA settings by default ------------
+    crowd_time_step: float = Field(0.25, gt=0, description="agents: time between ORCA "
+                                   "steps, s (CrowdNav: 0.25)")
+    crowd_neighbor_dist: float = Field(10.0, gt=0, description="agents: others farther than "
+                                       "this are ignored, m (CrowdNav: 10)")
+    crowd_max_neighbors: int = Field(10, gt=0, description="agents: most neighbours "
+                                     "considered (CrowdNav: 10)")
+    crowd_time_horizon: float = Field(5.0, gt=0, description="agents: ORCA's time horizon "
+                                      "for other agents, s (CrowdNav: 5)")
+    crowd_time_horizon_obst: float = Field(5.0, gt=0, description="agents: ORCA's time "
+                                           "horizon for obstacles, s (CrowdNav: 5)")
+    crowd_radius_margin: float = Field(0.01, ge=0, description="agents: added to every "
+                                       "radius in ORCA, m (CrowdNav: 0.01)")
+    crowd_slow_within: float = Field(1.0, gt=0, description="agents: the preferred velocity "
+                                     "is the vector to the goal divided by this, capped at "
+                                     "the preferred speed, s (CrowdNav: 1)")
 
     @model_validator(mode="after")
     def _stamped_for_lockstep(self) -> Params:
@@ -63,3 +76,11 @@ class Params(BaseModel):
                              "Twist has no stamp to say which scan it answers); or use "
                              "clock=realtime")
         return self
+
+    def crowd(self) -> CrowdParams:
+        """The ORCA settings of the agents (:mod:`zenav.sim.agents`)."""
+        return CrowdParams(
+            time_step=self.crowd_time_step, neighbor_dist=self.crowd_neighbor_dist,
+            max_neighbors=self.crowd_max_neighbors, time_horizon=self.crowd_time_horizon,
+            time_horizon_obst=self.crowd_time_horizon_obst,
+            radius_margin=self.crowd_radius_margin, slow_within=self.crowd_slow_within)

@@ -52,7 +52,7 @@ class Simulation:
         self.min_clearance = math.inf
         self.outcome: Literal["reached", "collision", "timeout"] | None = None
         self.collided_with: int | None = None
-        self.crowd = Crowd(scenario, params.crowd)
+        self.crowd = Crowd(scenario, params.crowd())
         self.crowd.start(self._robot_motion(0.0, self.state, (0.0, 0.0)))
         self.agent_rows: list[deque[tuple[float, float, float]]] = [
             deque(maxlen=keep) for _ in self.crowd.ids]

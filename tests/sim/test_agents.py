@@ -211,3 +211,20 @@ def test_the_record_has_agents_only_with_agents():
     assert [row[0] for row in record["agents"]["0"]] == [row[0] for row in record["trajectory"]]
     plain = run_still(scenario(duration=1.0)).result()
     assert "agents" not in make_record(plain, [], "paper")
+
+
+def test_the_simulator_parameters_reach_orca():
+    """Two agents head-on: with CrowdNav's neighbour distance they pass each other; seeing
+    only 0.5 m around them, they meet."""
+    sc = scenario(agent(center=[1.0, 5.0], goals=[[9.0, 5.0]]),
+                  agent(center=[9.0, 5.05], goals=[[1.0, 5.0]]), start=(5.0, 1.0))
+
+    def closest(params: Params) -> float:
+        sim = Simulation(sc, params)
+        while sim.outcome is None:
+            sim.step(0.0, 0.0)
+        a, b = (p.rows for p in sim.result().agents)
+        return float((np.hypot(a[:, 1] - b[:, 1], a[:, 2] - b[:, 2]) - 0.6).min())
+
+    assert closest(Params(scenario="agents.yaml")) > 0.0
+    assert closest(Params(scenario="agents.yaml", crowd_neighbor_dist=0.5)) < 0.0
