@@ -207,14 +207,16 @@ class ObstacleSpec(_Model):
                 problems.append((("goals",), "behavior orca needs a non-empty list of goals"))
             if self.preferred_speed is None:
                 problems.append((("preferred_speed",), "required for behavior orca"))
-            if "velocity" in self.model_fields_set:
+            if self.velocity != (0.0, 0.0):
                 problems.append((("velocity",), "not allowed with behavior orca (an agent's "
                                  "velocity comes from ORCA)"))
         else:
-            given = self.model_fields_set
-            for name in ("goals", "preferred_speed", "sees_robot"):
-                if name in given:
-                    problems.append(((name,), "only for behavior: orca"))
+            # Defaults (as model_dump writes them) are fine; a value means an agent was meant.
+            given = {"goals": self.goals is not None,
+                     "preferred_speed": self.preferred_speed is not None,
+                     "sees_robot": self.sees_robot}
+            problems += [((name,), "only for behavior: orca") for name, set_ in given.items()
+                         if set_]
         return problems
 
     @property

@@ -228,3 +228,10 @@ def test_the_simulator_parameters_reach_orca():
 
     assert closest(Params(scenario="agents.yaml")) > 0.0
     assert closest(Params(scenario="agents.yaml", crowd_neighbor_dist=0.5)) < 0.0
+
+
+def test_a_scenario_dumped_by_pydantic_reads_back():
+    """model_dump writes every field, defaults included (goals: None, sees_robot: False on
+    a plain obstacle; velocity (0, 0) on an agent): that is no error."""
+    sc = scenario(agent(), {"shape": "disc", "center": [3.0, 3.0], "radius": 0.2})
+    assert parse_scenario(sc.model_dump(), "agents.yaml") == sc
