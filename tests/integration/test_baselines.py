@@ -27,7 +27,7 @@ def run(scenario: str, planner: str, out: Path) -> dict[str, Any]:
     return record
 
 
-@pytest.mark.parametrize("planner", ["vfh", "dwa", "apf"])
+@pytest.mark.parametrize("planner", ["vfh", "dwa", "apf", "orca"])
 def test_reaches_the_goal_with_no_obstacle(planner, tmp_path):
     record = run("a-no-obstacle.yaml", planner, tmp_path)
     goal = yaml.safe_load((SCENARIOS / "a-no-obstacle.yaml").read_text())["robot"]["goal"]
