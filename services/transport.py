@@ -278,9 +278,12 @@ class _ZenohToken(Token):
 class ZenohBus(Bus):
     """The bus over one Zenoh session, bridged to one asyncio loop."""
 
-    def __init__(self, config: TransportConfig, loop: asyncio.AbstractEventLoop) -> None:
+    def __init__(self, config: TransportConfig, loop: asyncio.AbstractEventLoop,
+                 session: Any = None) -> None:
+        """Opens a session from ``config``, or takes over ``session`` already opened from
+        it (a tool opens it in a thread of its own, to stay responsive while it connects)."""
         self._loop = loop
-        self._session: Any = zenoh.open(config.to_zenoh())
+        self._session: Any = zenoh.open(config.to_zenoh()) if session is None else session
         self._declared: list[Any] = []
 
     @property

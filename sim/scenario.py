@@ -310,6 +310,76 @@ class Scenario(_Model):
             raise _ProblemsError(problems)
         return self
 
+    @model_validator(mode="after")
+    def _within_limits(self) -> Scenario:
+        problems = limit_problems(self)
+        if problems:
+            raise _ProblemsError(problems)
+        return self
+
+
+# --- limits --------------------------------------------------------------------------
+# What the stack can carry, checked when the file is loaded: a scenario beyond them would
+# start six processes and then fail on a message that cannot be sent.
+
+MAX_OBSTACLES = 1000
+"""Obstacles in one scenario: the simulator's ground truth carries at most this many."""
+
+MAX_BEAMS = 4000
+"""Beams per scan: a frame of float32 ranges must fit the laser keys' 32 KB."""
+
+MAX_GRID_CELLS = 4_000_000
+"""Cells of the world grid (width / cell x height / cell): the planner's map is one array."""
+
+MAX_TICKS = 200_000
+"""Simulator ticks in a run (duration x max(rate_hz, 10)): the run's result carries one
+trajectory row per tick within its 16 MB."""
+
+
+def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
+    """Every way ``scenario`` exceeds what the stack can carry, or cannot succeed (a goal
+    no robot disc can reach), as (field, problem) pairs; empty when it is within limits."""
+    problems: list[tuple[Loc, str]] = []
+    count = len(scenario.obstacles)
+    if count > MAX_OBSTACLES:
+        problems.append((("obstacles",), f"at most {MAX_OBSTACLES} obstacles (got {count})"))
+    beams = scenario.laser.beam_count
+    if beams > MAX_BEAMS:
+        problems.append((("laser", "resolution_deg"), f"at most {MAX_BEAMS} beams per scan "
+                         f"(got {beams}: fov_deg / resolution_deg + 1)"))
+    width, height = scenario.world.size
+    cells = math.ceil(width / scenario.world.cell) * math.ceil(height / scenario.world.cell)
+    if cells > MAX_GRID_CELLS:
+        problems.append((("world", "cell"), f"at most {MAX_GRID_CELLS} grid cells "
+                         f"(got {cells}: a larger cell or a smaller world)"))
+    ticks = scenario.duration * max(scenario.laser.rate_hz, 10.0)
+    if ticks > MAX_TICKS:
+        problems.append((("duration",), f"at most {MAX_TICKS} simulator ticks (got "
+                         f"{ticks:.0f}: duration x max(laser.rate_hz, 10))"))
+    robot = scenario.robot
+    for i, obstacle in enumerate(scenario.obstacles):
+        if count > MAX_OBSTACLES:
+            break  # the count is the problem; one line, not a thousand
+        for field, extent in (("size", obstacle.size), ("radius", obstacle.radius)):
+            if extent is None:
+                continue
+            largest = max(extent) if isinstance(extent, tuple) else 2 * extent
+            if largest > max(width, height):
+                problems.append(((f"obstacles[{i}]", field), f"larger than the world "
+                                 f"({largest:g} m across, world {width:g} x {height:g} m)"))
+        forever = obstacle.appear <= 0.0 and obstacle.vanish is None
+        if not (obstacle.is_static and forever):
+            continue
+        to_goal = obstacle.signed_distance(robot.goal, 0.0)
+        # The point itself inside is _placement's problem. Free but too close: the robot
+        # disc standing on the goal would overlap the obstacle, and the run would wander
+        # until its timeout.
+        if 0.0 <= to_goal < robot.radius:
+            problems.append((("robot", "goal"), f"unreachable: the robot disc (radius "
+                             f"{robot.radius:g} m) at the goal overlaps static obstacles[{i}] "
+                             f"({obstacle.shape}, {to_goal:.3g} m from the goal)"))
+    return problems
+
 
 # --- loading -------------------------------------------------------------------------
 

@@ -38,10 +38,39 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command's exit status; SIGINT at any point (even while the modules load) ends it
+    quietly with 130, as a shell expects."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        return 130
+
+
+def _main(argv: list[str] | None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = build_parser()
     args, rest = parser.parse_known_args(argv)
     if rest and not getattr(args, "passes_rest", False):  # only `zenav service` passes them on
         parser.error(f"unrecognized arguments: {' '.join(rest)}")
     args.rest = rest
+    if (problem := _out_problem(args)) is not None:
+        print(f"zenav {args.command}: {problem}", file=sys.stderr)
+        return 2
     return int(args.func(args))
+
+
+def _out_problem(args: argparse.Namespace) -> str | None:
+    """Every command's ``--out`` folder is checked before it starts work: a bad one (an
+    existing file, a folder under a file, /proc or /sys) is one line, not a traceback."""
+    from pathlib import Path
+
+    from zenav.writable import PathError, check_output_dir
+
+    out = getattr(args, "out", None)
+    if not isinstance(out, Path):
+        return None
+    try:
+        check_output_dir(out)
+    except PathError as exc:
+        return str(exc)
+    return None

@@ -21,11 +21,17 @@ from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
 from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
-from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment
+from zenav.services.config import (
+    SERVICE_ORDER,
+    ConfigError,
+    Layer,
+    parse_assignment,
+    resolve,
+)
 from zenav.services.mission import stack_params
 from zenav.services.profiles import DEFAULT_PROFILE, apply_profile
 from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
-from zenav.services.runner import PLANNERS
+from zenav.services.runner import PLANNERS, service_params
 from zenav.services.transport import ZenohBus
 from zenav.sim.scenario import load_scenario
 
@@ -44,6 +50,32 @@ def apply_override(params: dict[str, dict[str, Any]], text: str) -> None:
     for part in path[1:-1]:
         target = target.setdefault(part, {})
     target[path[-1]] = value
+
+
+def check_overrides(params: dict[str, dict[str, Any]], overrides: list[str], planner: str,
+                    source: str) -> None:
+    """Validate each service's parameters with the ``--set`` overrides applied, before any
+    process starts: ConfigError with one line per problem, naming the flag that caused it
+    (not the parameter file the run would write from it)."""
+    by_service: dict[str, list[Layer]] = {}
+    for text in overrides:
+        path, value = parse_assignment(text)
+        if len(path) < 2 or path[0] not in SERVICE_ORDER:
+            raise ConfigError(f"--set {text!r}: expected SERVICE.NAME=VALUE with SERVICE one "
+                              f"of {', '.join(SERVICE_ORDER)}")
+        nested: dict[str, Any] = {path[-1]: value}
+        for part in reversed(path[1:-1]):
+            nested = {part: nested}
+        by_service.setdefault(path[0], []).append(Layer("--set", f"--set {text}", nested))
+    problems = []
+    for service, layers in by_service.items():
+        base = Layer("scenario", source, params.get(service, {}))
+        try:
+            resolve(service_params(service, planner), [base, *layers])
+        except ConfigError as exc:
+            problems.append(str(exc))
+    if problems:
+        raise ConfigError("\n".join(problems))
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -203,13 +235,15 @@ def run_scenario(
     under the scenario's values and ``overrides``."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
-        raise RunError(f"unknown planner {planner!r}; choose from {', '.join(PLANNERS)}")
+        raise ConfigError(f"--planner {planner!r}: no such planner; choose from "
+                          f"{', '.join(PLANNERS)}")
     params = stack_params(scenario, scenario_path, planner)
     apply_profile(params, profile, planner)  # raises ConfigError for an unknown profile
     if robot_face not in ROBOT_FACES:
         raise ConfigError(f"--robot {robot_face!r}: choose one of {', '.join(ROBOT_FACES)}")
     if robot_face == "ros2":
         params = with_ros2_robot(params)
+    check_overrides(params, overrides or [], planner, f"scenario {scenario_path}")
     for text in overrides or []:
         apply_override(params, text)
     out_dir.mkdir(parents=True, exist_ok=True)

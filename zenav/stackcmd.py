@@ -17,15 +17,16 @@ def _run(args: argparse.Namespace) -> int:
     from zenav.run import RunError, run_scenario
     from zenav.services.config import ConfigError
     from zenav.sim.scenario import ScenarioError
+    from zenav.writable import PathError, check_output_dir
 
     try:
+        check_output_dir(args.out)
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level,
                               robot_face=args.robot, mcap=args.record,
                               profile=args.profile)
-    except (ScenarioError, ConfigError) as exc:
-        # one line, every problem in it: "file: field: problem; file: field: problem"
-        print(f"zenav run: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
+    except (ScenarioError, ConfigError, PathError) as exc:
+        say_each("zenav run", exc)
         return 2
     except RunError as exc:
         print(f"zenav run: {exc}", file=sys.stderr)
@@ -38,6 +39,13 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def say_each(command: str, exc: BaseException) -> None:
+    """One line on stderr per problem the exception names (a file with three mistakes is
+    three lines: "zenav run: file: field: problem")."""
+    for line in str(exc).splitlines() or [type(exc).__name__]:
+        print(f"{command}: {line}", file=sys.stderr)
+
+
 def _service(args: argparse.Namespace) -> int:
     from zenav.services.runner import main as service_main
 
@@ -46,13 +54,25 @@ def _service(args: argparse.Namespace) -> int:
 
 def _schemas(args: argparse.Namespace) -> int:
     from zenav.schemas.messages import ALL_MESSAGES
+    from zenav.writable import PathError, check_output_dir
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    for message in ALL_MESSAGES:
-        schema = message.model_json_schema(mode="serialization")
-        path = args.out / f"{message.TYPE}.schema.json"
-        path.write_text(json.dumps(schema, indent=2) + "\n")
-        print(path)
+    schemas = {m.TYPE: m.model_json_schema(mode="serialization") for m in ALL_MESSAGES}
+    if args.out is None:  # no folder given: one JSON document on stdout, nothing written
+        print(json.dumps(schemas, indent=2))
+        return 0
+    try:
+        check_output_dir(args.out)
+        for name, schema in schemas.items():
+            path = args.out / f"{name}.schema.json"
+            path.write_text(json.dumps(schema, indent=2) + "\n")
+            print(path)
+    except PathError as exc:
+        print(f"zenav schemas: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"zenav schemas: {args.out}: cannot write ({exc.strerror or exc})",
+              file=sys.stderr)
+        return 2
     return 0
 
 
@@ -83,5 +103,7 @@ def add_commands(sub: Any) -> None:
     service.set_defaults(func=_service, passes_rest=True)
 
     schemas = sub.add_parser("schemas", help="write the JSON Schema of every message")
-    schemas.add_argument("--out", type=Path, default=Path("schemas/json"))
+    schemas.add_argument("--out", type=Path, metavar="DIR",
+                         help="write TYPE.schema.json files into DIR (default: print one "
+                         "JSON object of every schema, by message type, on stdout)")
     schemas.set_defaults(func=_schemas)

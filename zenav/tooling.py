@@ -26,6 +26,10 @@ log = logging.getLogger(__name__)
 
 T = TypeVar("T")
 
+CONNECT_TIMEOUT = 5.0
+"""Seconds a tool (monitor, record, replay, ``zenav up``'s wait) waits for its router
+before it gives up with one line saying so (``--connect-timeout``)."""
+
 CLIENT_EXTRA: dict[str, Any] = {
     # Wait for the router instead of failing to open when it is not up yet (a service
     # under a supervisor may start before the router, or before the link is up).
@@ -50,10 +54,97 @@ def client_transport(connect: list[str], **extra: Any) -> TransportConfig:
 
 
 def tool_transport(args: argparse.Namespace) -> TransportConfig:
-    """Transport of a tool from the shared transport options (see module doc)."""
+    """Transport of a tool from the shared transport options (see module doc). A client
+    gives up on a missing router after ``--connect-timeout`` s instead of waiting forever."""
     if args.connect and args.mode is None and args.transport is None:
-        return client_transport(list(args.connect))
-    return with_client_defaults(transport_from_args(args, None))
+        config = client_transport(list(args.connect))
+    else:
+        config = with_client_defaults(transport_from_args(args, None))
+    return with_connect_timeout(config, getattr(args, "connect_timeout", CONNECT_TIMEOUT))
+
+
+def with_connect_timeout(config: TransportConfig, timeout: float) -> TransportConfig:
+    """``config`` whose first connection to a router fails after ``timeout`` s (a client's
+    default here is to wait forever, right for a supervised service, wrong for a tool)."""
+    if config.mode != "client":
+        return config
+    extra = {**config.extra, "connect/timeout_ms": max(1, round(timeout * 1000)),
+             "connect/exit_on_failure": True}
+    return config.model_copy(update={"extra": extra})
+
+
+def add_connect_timeout(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--connect-timeout", type=float, default=CONNECT_TIMEOUT, metavar="S",
+                        help="s to wait for the router before giving up "
+                        f"(default {CONNECT_TIMEOUT:g})")
+
+
+class ConnectError(RuntimeError):
+    """The session could not be opened; the message is the one-line reason."""
+
+
+def connect_problem(transport: TransportConfig, timeout: float, exc: BaseException | None
+                    ) -> str:
+    """The one line a tool prints when its session does not open."""
+    if transport.mode == "client":
+        where = ", ".join(transport.connect) or "(no endpoint)"
+        return f"no Zenoh router at {where} after {timeout:g} s: is it running?"
+    detail = f": {str(exc).split(' at ')[0]}" if exc is not None else ""
+    return f"cannot open a Zenoh {transport.mode} session within {timeout:g} s{detail}"
+
+
+async def open_bus(transport: TransportConfig, stop: asyncio.Event,
+                   timeout: float = CONNECT_TIMEOUT) -> ZenohBus | None:
+    """A :class:`ZenohBus` on the running loop, its session opened in a thread of its own:
+    opening blocks the calling thread while a client looks for its router, and a blocked
+    main thread would ignore SIGINT, SIGTERM and ``--duration``. None when ``stop`` is set
+    first; :class:`ConnectError` when the session does not open within ``timeout`` s (plus
+    a grace second: a client's own connect timeout is ``timeout``)."""
+    import zenoh
+
+    loop = asyncio.get_running_loop()
+    opened: asyncio.Future[Any] = loop.create_future()
+    conf = transport.to_zenoh()
+
+    def deliver(session: Any, exc: BaseException | None) -> None:
+        if opened.done():  # nobody waits any more: close what came too late
+            if session is not None:
+                with contextlib.suppress(Exception):
+                    session.close()
+        elif exc is not None:
+            opened.set_exception(exc)
+        else:
+            opened.set_result(session)
+
+    def work() -> None:
+        session: Any = None
+        error: BaseException | None = None
+        try:
+            session = zenoh.open(conf)
+        except Exception as exc:  # handed to the loop
+            error = exc
+        try:
+            loop.call_soon_threadsafe(deliver, session, error)
+        except RuntimeError:  # the loop is closed: the tool stopped meanwhile
+            if session is not None:
+                with contextlib.suppress(Exception):
+                    session.close()
+
+    threading.Thread(target=work, name="zenav-open", daemon=True).start()
+    stopped = asyncio.ensure_future(stop.wait())
+    try:
+        await asyncio.wait({opened, stopped}, timeout=timeout + 1.0,
+                           return_when=asyncio.FIRST_COMPLETED)
+    finally:
+        stopped.cancel()
+    if not opened.done():
+        opened.cancel()
+        if stop.is_set():
+            return None
+        raise ConnectError(connect_problem(transport, timeout, None))
+    if opened.exception() is not None:
+        raise ConnectError(connect_problem(transport, timeout, opened.exception()))
+    return ZenohBus(transport, loop, session=opened.result())
 
 
 def tool_setup(args: argparse.Namespace, command: str) -> tuple[str, TransportConfig] | None:

@@ -13,6 +13,7 @@ from typing import IO, Any
 
 import msgpack
 from mcap.decoder import DecoderFactory
+from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Schema
 from mcap.writer import Writer
@@ -157,6 +158,28 @@ def recorded_robot(path: Path) -> str:
             if record.name == "zenav":
                 return record.metadata["robot_id"]
     raise ValueError(f"{path}: no zenav metadata record (not made by zenav record)")
+
+
+def bag_contents(path: Path) -> tuple[str, set[str]]:
+    """(robot id, topics with messages) of a file made by ``zenav record``; ValueError with
+    one line when it is not one (unreadable, not MCAP, no zenav metadata)."""
+    try:
+        robot = recorded_robot(path)
+        prefix = f"{ROOT}/{robot}/"
+        with path.open("rb") as stream:
+            summary = make_reader(stream).get_summary()
+            if summary is not None:
+                channels = summary.channels.values()
+                counts = summary.statistics.channel_message_counts if summary.statistics else {}
+                topics = {c.topic[len(prefix):] for c in channels
+                          if c.topic.startswith(prefix) and c.message_encoding == MESSAGE_ENCODING
+                          and counts.get(c.id, 1) > 0}
+                return robot, topics
+        return robot, {item.topic for item in read_bag(path)}
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except McapError:
+        raise ValueError(f"{path}: not an MCAP file (or cut short)") from None
 
 
 def read_bag(path: Path, topics: set[str] | None = None) -> Iterator[Recorded]:

@@ -6,27 +6,47 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
 from zenav.bag.mcapfile import BagWriter
 from zenav.services.runner import add_transport_arguments
-from zenav.services.transport import ZenohBus
-from zenav.tooling import StampedSubscriber, stop_on_signals, tool_setup, wait_for_event
+from zenav.tooling import (
+    CONNECT_TIMEOUT,
+    ConnectError,
+    StampedSubscriber,
+    add_connect_timeout,
+    open_bus,
+    stop_on_signals,
+    tool_setup,
+    wait_for_event,
+)
+from zenav.writable import PathError, check_output_file
 
 
 async def record(transport: Any, robot_id: str, path: Path, *, duration: float | None,
-                 exclude: tuple[str, ...]) -> tuple[int, int]:
-    """Record until SIGINT/SIGTERM or ``duration``; (messages, liveliness changes)."""
+                 exclude: tuple[str, ...], connect_timeout: float = CONNECT_TIMEOUT
+                 ) -> tuple[int, int] | None:
+    """Record until SIGINT/SIGTERM or ``duration``; (messages, liveliness changes), or
+    None when stopped before the session opened (then no file is written)."""
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     stop_on_signals(stop)
+    if duration is not None:
+        loop.call_later(duration, stop.set)
     changes = 0
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("wb") as stream:
+    bus = await open_bus(transport, stop, connect_timeout)
+    if bus is None:
+        return None
+    try:
+        stream = path.open("wb")
+    except BaseException:
+        bus.close()
+        raise
+    with stream:
         writer = BagWriter(stream, robot_id, exclude, foxglove=True)
-        bus = ZenohBus(transport, loop)
         try:
             subscriber = StampedSubscriber(bus, writer.keys.everything, writer.add)
 
@@ -40,7 +60,7 @@ async def record(transport: Any, robot_id: str, path: Path, *, duration: float |
             # clock only when nothing can be missed.
             token = bus.declare_token(writer.keys.alive("record"))
             print(f"zenav record: recording {writer.keys.everything} to {path}", flush=True)
-            await wait_for_event(stop, duration)
+            await wait_for_event(stop, None)
             token.undeclare()
             subscriber.close()
         finally:
@@ -55,13 +75,32 @@ def main(args: argparse.Namespace) -> int:
     if setup is None:
         return 2
     robot_id, transport = setup
+    try:
+        check_output_file(args.file)
+    except PathError as exc:
+        print(f"zenav record: {exc}", file=sys.stderr)
+        return 2
     started = time.monotonic()
-    with contextlib.suppress(KeyboardInterrupt):
-        count, changes = asyncio.run(record(transport, robot_id, args.file,
-                                            duration=args.duration, exclude=tuple(args.exclude)))
-        print(f"zenav record: {count} messages and {changes} liveliness changes in "
-              f"{time.monotonic() - started:.1f} s -> {args.file} "
-              f"({args.file.stat().st_size} B)", flush=True)
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            done = asyncio.run(record(transport, robot_id, args.file, duration=args.duration,
+                                      exclude=tuple(args.exclude),
+                                      connect_timeout=args.connect_timeout))
+            if done is None:
+                print("zenav record: stopped before the session opened; nothing recorded",
+                      file=sys.stderr)
+                return 1
+            count, changes = done
+            print(f"zenav record: {count} messages and {changes} liveliness changes in "
+                  f"{time.monotonic() - started:.1f} s -> {args.file} "
+                  f"({args.file.stat().st_size} B)", flush=True)
+    except ConnectError as exc:
+        print(f"zenav record: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"zenav record: {args.file}: cannot write ({exc.strerror or exc})",
+              file=sys.stderr)
+        return 2
     return 0
 
 
@@ -73,4 +112,5 @@ def add_command(sub: Any) -> None:
     record.add_argument("--exclude", action="append", default=[], metavar="TOPIC",
                         help="leave out a topic, e.g. sim/truth (repeatable)")
     add_transport_arguments(record)
+    add_connect_timeout(record)
     record.set_defaults(func=main)

@@ -9,25 +9,46 @@ import time
 from pathlib import Path
 from typing import Any
 
-from zenav.bag.mcapfile import read_bag, recorded_robot
+from zenav.bag.mcapfile import bag_contents, read_bag
 from zenav.schemas.keys import Keys
 from zenav.services.config import ConfigError
 from zenav.services.runner import add_transport_arguments
-from zenav.services.transport import ZenohBus
-from zenav.tooling import stop_on_signals, tool_transport, wait_for_event
+from zenav.tooling import (
+    CONNECT_TIMEOUT,
+    ConnectError,
+    add_connect_timeout,
+    open_bus,
+    stop_on_signals,
+    tool_transport,
+    wait_for_event,
+)
+
+
+def check_replay(path: Path, topics: set[str] | None, rate: float) -> str:
+    """The recorded robot id, once the input and options make sense; ValueError with one
+    line naming the problem (not MCAP, no such topic in the file, a bad rate)."""
+    if rate <= 0:
+        raise ValueError(f"--rate must be > 0 (got {rate})")
+    robot, recorded = bag_contents(path)
+    unknown = sorted((topics or set()) - recorded)
+    if unknown:
+        raise ValueError(f"--topics: {', '.join(unknown)} not in {path} (it has "
+                         f"{', '.join(sorted(recorded)) or 'no messages'})")
+    return robot
 
 
 async def replay(transport: Any, path: Path, *, rate: float, topics: set[str] | None,
-                 as_robot: str | None, wait_for: list[str], timeout: float) -> int:
+                 as_robot: str | None, wait_for: list[str], timeout: float,
+                 connect_timeout: float = CONNECT_TIMEOUT) -> int:
     """Publish the file's messages again; the number published."""
-    if rate <= 0:
-        raise ValueError(f"--rate must be > 0 (got {rate})")
-    source = recorded_robot(path)
+    source = check_replay(path, topics, rate)
     target = Keys(as_robot or source)
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     stop_on_signals(stop)
-    bus = ZenohBus(transport, loop)
+    bus = await open_bus(transport, stop, connect_timeout)
+    if bus is None:
+        return 0
     published = 0
     try:
         if wait_for:
@@ -81,10 +102,11 @@ def main(args: argparse.Namespace) -> int:
         if args.as_robot is not None:
             Keys(args.as_robot)
         started = time.monotonic()
+        check_replay(args.file, topics, args.rate)  # before the session: bad input is exit 2
         count = asyncio.run(replay(transport, args.file, rate=args.rate, topics=topics,
                                    as_robot=args.as_robot, wait_for=wait_for,
-                                   timeout=args.timeout))
-    except TimeoutError as exc:  # before OSError, of which it is a subclass
+                                   timeout=args.timeout, connect_timeout=args.connect_timeout))
+    except (TimeoutError, ConnectError) as exc:  # before OSError, of which it is a subclass
         print(f"zenav replay: {exc}", file=sys.stderr)
         return 1
     except (ConfigError, ValueError, OSError) as exc:
@@ -112,4 +134,5 @@ def add_command(sub: Any) -> None:
     replay.add_argument("--timeout", type=float, default=30.0,
                         help="s to wait for --wait-for (default 30)")
     add_transport_arguments(replay)
+    add_connect_timeout(replay)
     replay.set_defaults(func=main)

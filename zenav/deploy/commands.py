@@ -15,7 +15,7 @@ from typing import Any
 from zenav.deploy.conf import default_run_dir, prepare, socket_path
 from zenav.deploy.model import DEFAULT_CONFIG, Deployment, load_deployment
 from zenav.deploy.rpc import Supervisor, unclean_stops
-from zenav.deploy.wait import expected_alive, wait_alive, wait_running
+from zenav.deploy.wait import check_started, expected_alive, wait_alive, wait_running
 from zenav.services.config import ConfigError
 
 
@@ -69,16 +69,22 @@ def cmd_up(args: argparse.Namespace) -> int:
             programs.insert(0, "router")
         wait_running(sup, programs, args.timeout)
         if not args.no_wait:
-            missing = wait_alive(deployment, expected_alive(deployment), args.timeout)
+            missing = wait_alive(deployment, expected_alive(deployment), args.timeout,
+                                 check=lambda: check_started(sup, programs))
             if missing:
-                raise ConfigError(f"running, but not on the bus after {args.timeout:.0f} s: "
-                                  f"{', '.join(sorted(missing))} (is the router at "
+                check_started(sup, programs)
+                raise ConfigError(f"running, but still waiting on {', '.join(sorted(missing))} "
+                                  f"on the bus after {args.timeout:.0f} s (is the router at "
                                   f"{', '.join(deployment.transport.connect)} reachable?). "
                                   "Left running: they join when it is; `zenav down` stops "
                                   "them")
     except ConfigError as exc:
         print(f"zenav up: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("zenav up: interrupted; what started is left running (`zenav down` stops it)",
+              file=sys.stderr)
+        return 130
     where = "" if args.run_dir is None and args.config is None else (
         f" --run-dir {run_dir}" if args.run_dir else f" --config {args.config}")
     print(f"zenav up: {deployment.name}: {', '.join(programs)} running"
@@ -124,7 +130,14 @@ def cmd_down(args: argparse.Namespace) -> int:
 def cmd_ctl(args: argparse.Namespace) -> int:
     if (resolved := _resolve_or_say(args)) is None:
         return 2
-    return Supervisor(resolved[1]).ctl(list(args.args) or ["status"])
+    deployment, run_dir = resolved
+    sup = Supervisor(run_dir)
+    if sup.pid() is None:
+        name = deployment.name if deployment else run_dir.name
+        print(f"zenav ctl: {name} is not up ({run_dir}); start it with `zenav up`",
+              file=sys.stderr)
+        return 1
+    return sup.ctl(list(args.args) or ["status"])
 
 
 def _add_common(parser: argparse.ArgumentParser) -> None:

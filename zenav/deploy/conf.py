@@ -206,7 +206,9 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
             f"priority={priority}",
             f"autostart={str(autostart).lower()}",
             f"autorestart={sup.autorestart}",
-            "exitcodes=0",
+            # 2 is a service's "bad parameter or input": restarting cannot help, so
+            # supervisord leaves it EXITED and `zenav up` reports the service's own line.
+            "exitcodes=0,2",
             f"startsecs={sup.startsecs}",
             f"startretries={sup.startretries}",
             "stopsignal=TERM",

@@ -52,7 +52,7 @@ class SupervisorSpec(BaseModel):
         "unexpected", description="restart a program that exits with a status other than 0 "
         "or is killed")
     startsecs: int = Field(1, ge=0, description="s a program must stay up to count as started")
-    startretries: int = Field(5, ge=0, description="failed starts in a row before FATAL")
+    startretries: int = Field(3, ge=0, description="failed starts in a row before FATAL")
     stopwaitsecs: int = Field(5, ge=1, description="s after SIGTERM before SIGKILL")
     log_maxbytes: str = "10MB"
     log_backups: int = Field(3, ge=0)

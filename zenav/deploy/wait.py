@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from zenav.deploy.conf import secured_transport
@@ -13,26 +14,47 @@ from zenav.deploy.model import Deployment
 from zenav.deploy.rpc import Supervisor
 from zenav.schemas.keys import Keys
 from zenav.services.config import ConfigError
-from zenav.services.transport import TransportConfig, ZenohBus
+from zenav.services.transport import TransportConfig
+from zenav.tooling import ConnectError, open_bus, stop_on_signals, with_connect_timeout
+
+FAILED_STATES = ("FATAL", "BACKOFF", "EXITED")
+"""supervisord states of a program that did not stay up: given up on, waiting to be
+started again after an early exit, or exited."""
 
 
-def _tail(path: Path, lines: int = 3) -> str:
+def _reason(log: Path) -> str:
+    """The line of a program's log that says why it stopped: its last error line (a
+    service prints its one-line reason on stderr, which goes to the same log), else its
+    last line."""
     try:
-        text = path.read_text(errors="replace").splitlines()
+        lines = [line.strip() for line in log.read_text(errors="replace").splitlines()
+                 if line.strip()]
     except OSError:
-        return ""
-    return " | ".join(line.strip() for line in text[-lines:] if line.strip())
+        return "(no log)"
+    for line in reversed(lines):
+        if line.startswith("zenav ") or " ERROR " in line or line.startswith(
+                ("Traceback", "ModuleNotFoundError", "ImportError")):
+            return line
+    return lines[-1] if lines else "(empty log)"
+
+
+def check_started(sup: Supervisor, programs: list[str]) -> None:
+    """ConfigError naming each program that exited since it was started, with its own
+    reason from its log (so a bad parameter is reported as such, not as a silent bus)."""
+    infos = sup.processes()
+    failed = [p for p in programs if infos.get(p, {}).get("statename") in FAILED_STATES]
+    if failed:
+        why = "; ".join(f"{p} {infos[p]['statename'].lower()}: "
+                        f"{_reason(sup.run_dir / 'logs' / f'{p}.log')}" for p in failed)
+        raise ConfigError(f"could not start {', '.join(failed)}: {why}")
 
 
 def wait_running(sup: Supervisor, programs: list[str], timeout: float) -> None:
-    """Until every program is RUNNING; a FATAL or BACKOFF-looping one raises ConfigError."""
+    """Until every program is RUNNING; one that exits or fails raises ConfigError."""
     deadline = time.monotonic() + timeout
     while True:
+        check_started(sup, programs)
         infos = sup.processes()
-        fatal = [p for p in programs if infos.get(p, {}).get("statename") == "FATAL"]
-        if fatal:
-            why = "; ".join(f"{p}: {_tail(sup.run_dir / 'logs' / f'{p}.log')}" for p in fatal)
-            raise ConfigError(f"could not start {', '.join(fatal)}: {why}")
         waiting = [p for p in programs if infos.get(p, {}).get("statename") != "RUNNING"]
         if not waiting:
             return
@@ -42,25 +64,40 @@ def wait_running(sup: Supervisor, programs: list[str], timeout: float) -> None:
         time.sleep(0.1)
 
 
-def wait_alive(deployment: Deployment, services: set[str], timeout: float) -> set[str]:
+def wait_alive(deployment: Deployment, services: set[str], timeout: float,
+               check: Callable[[], None] = lambda: None) -> set[str]:
     """Services among ``services`` whose liveliness token is not on the bus after
-    ``timeout`` s (empty when all are)."""
+    ``timeout`` s (empty when all are). ``check`` is called every ``CHECK_EVERY`` s
+    meanwhile and may raise (a program that exited)."""
     transport = deployment.transport
     if deployment.security is not None:  # zenav up watches with the monitor's certificate
         transport = secured_transport(deployment, "monitor")
-    if transport.mode == "client":
-        extra = {**transport.extra, "connect/timeout_ms": int(timeout * 1000)}
-        transport = transport.model_copy(update={"extra": extra})
+    transport = with_connect_timeout(transport, timeout)
     return asyncio.run(_missing_tokens(transport, Keys(deployment.robot_id), services,
-                                       time.monotonic() + timeout))
+                                       time.monotonic() + timeout, check))
+
+
+CHECK_EVERY = 0.25
+"""s between two looks at the programs' states while waiting for their tokens."""
 
 
 async def _missing_tokens(transport: TransportConfig, keys: Keys, services: set[str],
-                          deadline: float) -> set[str]:
+                          deadline: float, check: Callable[[], None]) -> set[str]:
+    stop = asyncio.Event()
+    stop_on_signals(stop)
+    left = max(0.1, deadline - time.monotonic())
+    opening = asyncio.ensure_future(open_bus(transport, stop, left))
     try:
-        bus = ZenohBus(transport, asyncio.get_running_loop())
-    except Exception:
+        while not opening.done():
+            check()
+            await asyncio.wait({opening}, timeout=CHECK_EVERY)
+        bus = opening.result()
+    except ConnectError:
         return set(services)
+    finally:
+        opening.cancel()
+    if bus is None:  # SIGINT or SIGTERM
+        raise KeyboardInterrupt
     missing = set(services)
     seen = asyncio.Event()
 
@@ -72,9 +109,12 @@ async def _missing_tokens(transport: TransportConfig, keys: Keys, services: set[
     try:
         bus.watch_liveliness(keys.alive_any, on_liveliness)
         while missing and (left := deadline - time.monotonic()) > 0:
+            if stop.is_set():
+                raise KeyboardInterrupt
+            check()
             seen.clear()
             with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(seen.wait(), timeout=left)
+                await asyncio.wait_for(seen.wait(), timeout=min(left, CHECK_EVERY))
     finally:
         bus.close()
     return missing

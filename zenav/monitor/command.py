@@ -14,20 +14,30 @@ from typing import IO, Any
 from zenav.monitor.model import MonitorModel
 from zenav.monitor.screen import render
 from zenav.services.runner import add_transport_arguments
-from zenav.services.transport import ZenohBus
-from zenav.tooling import StampedSubscriber, stop_on_signals, tool_setup, wait_for_event
+from zenav.tooling import (
+    CONNECT_TIMEOUT,
+    ConnectError,
+    StampedSubscriber,
+    add_connect_timeout,
+    open_bus,
+    stop_on_signals,
+    tool_setup,
+    wait_for_event,
+)
 
 
 async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
                   duration: float | None, silence: float = 0.5,
-                  out: IO[str] = sys.stdout) -> None:
+                  out: IO[str] = sys.stdout, connect_timeout: float = CONNECT_TIMEOUT) -> None:
     model = MonitorModel(robot_id, silence_after=silence)
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     stop_on_signals(stop)
     if duration is not None:
         loop.call_later(duration, stop.set)
-    bus = ZenohBus(transport, loop)
+    bus = await open_bus(transport, stop, connect_timeout)
+    if bus is None:  # stopped while connecting
+        return
     subscriber = StampedSubscriber(
         bus, model.keys.everything,
         lambda key, payload, ns: model.on_sample(key, payload, ns / 1e9))
@@ -64,9 +74,14 @@ def main(args: argparse.Namespace) -> int:
     if setup is None:
         return 2
     robot_id, transport = setup
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
-                            duration=args.duration, silence=args.silence))
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            asyncio.run(monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
+                                duration=args.duration, silence=args.silence,
+                                connect_timeout=args.connect_timeout))
+    except ConnectError as exc:
+        print(f"zenav monitor: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -85,4 +100,5 @@ def add_command(sub: Any) -> None:
                          help="a topic silent this long (s, at least 4 typical gaps) counts "
                          "as stopped (default 0.5)")
     add_transport_arguments(monitor)
+    add_connect_timeout(monitor)
     monitor.set_defaults(func=main)
