@@ -40,13 +40,16 @@ on any input (its view of the stack's clock). A later stamp is refused as ``futu
 accepted, it would make every genuine message after it look out of order."""
 
 RESYNC_AFTER = 1.0
-RESYNC_COUNT = 5
+RESYNC_COUNT = 3
 """The way back after a long link cut (stamps jump ahead) or a restarted publisher
 (stamps start again): once nothing has been accepted for ``RESYNC_AFTER`` wall seconds
 (on the key for a past stamp, on any input for a future one), ``RESYNC_COUNT`` refused
 stamps in a row on one key that form a coherent stream (increasing, each within
-``MAX_FUTURE`` of the one before) are taken as the new order. A lone stamp, or scattered
-ones, never move the clock."""
+``MAX_FUTURE`` of the one before; a repeated stamp neither counts nor breaks the run)
+are taken as the new order. A lone stamp, or scattered ones, never move the clock. Three
+at 10 Hz is 0.2 s from a restarted publisher's first message to its acceptance, well
+within the motor bridge's stale timeout (0.5 s); the :class:`StampGate` of a service that
+answers the key follows at once."""
 
 
 class TypedPublisher(Generic[M]):
@@ -126,6 +129,8 @@ class Node:
         """Newest stamp accepted on any input: the service's view of the stack's clock."""
         self._latest: dict[str, tuple[float, float]] = {}  # key -> (stamp, wall accepted)
         self._refused: dict[str, tuple[float, int]] = {}  # key -> (last stamp, run length)
+        self.resyncs: Counter[str] = Counter()
+        """Per key, how often its order restarted (a :class:`StampGate` follows it)."""
         self._status = TypedPublisher[ServiceStatus](
             bus.publisher(keys.status(name)), Topic(f"status/{name}", ServiceStatus)
         )
@@ -236,7 +241,9 @@ class Node:
             # A refused stamp counts toward a resynchronisation only as part of a
             # coherent stream: increasing, each within max_future of the one before.
             run = self._refused.get(key)
-            if run is not None and run[0] < stamp <= run[0] + self.max_future:
+            if run is not None and run[0] == stamp:
+                pass  # a retransmission of the run's newest stamp: neither more nor less
+            elif run is not None and run[0] < stamp <= run[0] + self.max_future:
                 run = (stamp, run[1] + 1)
             else:
                 run = (stamp, 1)
@@ -247,6 +254,7 @@ class Node:
                         "restarts at %s", self.name, key, silent, run[1], stamp)
             if problem[0] == "future":
                 self.clock = stamp
+            self.resyncs[key] += 1
         self._refused.pop(key, None)
         self._latest[key] = (stamp, now)
         self._accepted_wall = now
@@ -286,13 +294,21 @@ class StampGate:
     ``check(stamp)`` answers ``"new"`` for a stamp later than any seen, ``"repeat"`` for
     the latest one again (a retransmission: answer it by republishing the last output),
     and ``"old"`` for anything earlier (out of order: drop it). ``admit`` does all three
-    for a service whose output answers this input.
+    for a service whose output answers this input. When the node has restarted the
+    key's order (a restarted publisher, see :data:`RESYNC_COUNT`), the gate restarts with
+    it: the first stamp of the new order is new, not old.
     """
 
     def __init__(self, node: Node | None = None, topic: Topic | None = None) -> None:
         self.last: float | None = None
         self.node = node
         self.topic = topic
+        self._resyncs = self._node_resyncs()
+
+    def _node_resyncs(self) -> int:
+        if self.node is None or self.topic is None:
+            return 0
+        return self.node.resyncs[self.node.keys.of(self.topic)]
 
     def admit(self, stamp: float, output: Republisher) -> bool:
         """True for a new stamp; a repeat is answered with ``output``'s last message, an
@@ -306,6 +322,10 @@ class StampGate:
         return order == "new"
 
     def check(self, stamp: float) -> str:
+        resyncs = self._node_resyncs()
+        if resyncs != self._resyncs:  # the node took a new order on this key
+            self._resyncs = resyncs
+            self.last = None
         if self.last is None or stamp > self.last:
             self.last = stamp
             return "new"

@@ -93,13 +93,19 @@ def connect_problem(transport: TransportConfig, timeout: float, exc: BaseExcepti
     return f"cannot open a Zenoh {transport.mode} session within {timeout:g} s{detail}"
 
 
+WAITING_NOTE_AFTER = 1.0
+"""s after which a tool still connecting says on stderr what it waits for."""
+
+
 async def open_bus(transport: TransportConfig, stop: asyncio.Event,
-                   timeout: float = CONNECT_TIMEOUT) -> ZenohBus | None:
+                   timeout: float = CONNECT_TIMEOUT, command: str | None = None
+                   ) -> ZenohBus | None:
     """A :class:`ZenohBus` on the running loop, its session opened in a thread of its own:
     opening blocks the calling thread while a client looks for its router, and a blocked
     main thread would ignore SIGINT, SIGTERM and ``--duration``. None when ``stop`` is set
     first; :class:`ConnectError` when the session does not open within ``timeout`` s (plus
-    a grace second: a client's own connect timeout is ``timeout``)."""
+    a grace second: a client's own connect timeout is ``timeout``). With ``command``, a
+    client still waiting after :data:`WAITING_NOTE_AFTER` s says so on stderr."""
     import zenoh
 
     loop = asyncio.get_running_loop()
@@ -133,6 +139,12 @@ async def open_bus(transport: TransportConfig, stop: asyncio.Event,
     threading.Thread(target=work, name="zenav-open", daemon=True).start()
     stopped = asyncio.ensure_future(stop.wait())
     try:
+        if command is not None and transport.mode == "client" and timeout > WAITING_NOTE_AFTER:
+            await asyncio.wait({opened, stopped}, timeout=WAITING_NOTE_AFTER,
+                               return_when=asyncio.FIRST_COMPLETED)
+            if not (opened.done() or stopped.done()):
+                print(f"{command}: waiting for the router at {', '.join(transport.connect)} "
+                      f"(up to {timeout:g} s)", file=sys.stderr, flush=True)
         await asyncio.wait({opened, stopped}, timeout=timeout + 1.0,
                            return_when=asyncio.FIRST_COMPLETED)
     finally:

@@ -199,3 +199,24 @@ async def test_the_order_restarts_after_a_silence_on_a_coherent_stream_only() ->
         h.send(keys.ODOM, odom(1.6))
         await h.settle()
         assert h.node.rejected["out_of_order"] == RESYNC_COUNT - 1
+
+
+async def test_a_restarted_publisher_is_answered_from_its_third_message() -> None:
+    """A restarted planner (or a simulator whose clock starts again) sends stamps earlier
+    than the last ones seen: after the silence its third coherent stamp restarts the
+    order, and the motor bridge's gate follows the node at once (it used to refuse the
+    new order for good). A repeated stamp in between neither counts nor breaks the run."""
+    async with running("motor_bridge", BridgeParams(accel=10.0)) as h:
+        h.node.resync_after = 0.2
+        for t in (100.0, 100.1):
+            h.send(keys.ODOM, odom(t))
+            h.send(keys.CMD_VEL, cmd(t))
+            await h.settle()
+        await asyncio.sleep(0.25)  # the publisher is down longer than resync_after
+        for t in (1.0, 1.0, 1.1, 1.2, 1.3):
+            h.send(keys.CMD_VEL, cmd(t))
+            await h.settle()
+        assert RESYNC_COUNT == 3
+        assert h.node.rejected["out_of_order"] == 3  # 1.0, its repeat, 1.1
+        assert h.node.resyncs[h.node.keys.of(keys.CMD_VEL)] == 1
+        assert [c.stamp for c in h.received(keys.BASE_CMD, BaseCommand)][-2:] == [1.2, 1.3]

@@ -37,7 +37,7 @@ async def record(transport: Any, robot_id: str, path: Path, *, duration: float |
     if duration is not None:
         loop.call_later(duration, stop.set)
     changes = 0
-    bus = await open_bus(transport, stop, connect_timeout)
+    bus = await open_bus(transport, stop, connect_timeout, "zenav record")
     if bus is None:
         return None
     try:

@@ -46,7 +46,7 @@ async def replay(transport: Any, path: Path, *, rate: float, topics: set[str] | 
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     stop_on_signals(stop)
-    bus = await open_bus(transport, stop, connect_timeout)
+    bus = await open_bus(transport, stop, connect_timeout, "zenav replay")
     if bus is None:
         return 0
     published = 0

@@ -35,7 +35,7 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
     stop_on_signals(stop)
     if duration is not None:
         loop.call_later(duration, stop.set)
-    bus = await open_bus(transport, stop, connect_timeout)
+    bus = await open_bus(transport, stop, connect_timeout, "zenav monitor")
     if bus is None:  # stopped while connecting
         return
     subscriber = StampedSubscriber(
