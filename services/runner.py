@@ -199,7 +199,8 @@ def main(name: str, argv: list[str] | None = None) -> int:
         keys = Keys(check_robot_id(args.robot_id))
         transport = transport_from_args(args, name)
     except (ConfigError, ValueError) as exc:
-        print(f"zenav {name}: {exc}", file=sys.stderr)
+        for line in str(exc).splitlines():  # one line per problem, each naming the service
+            print(f"zenav {name}: {line}", file=sys.stderr)
         return 2
 
     async def amain() -> None:

@@ -38,8 +38,14 @@ def _resolve_or_say(args: argparse.Namespace) -> tuple[Deployment | None, Path] 
     try:
         return _resolve(args)
     except ConfigError as exc:
-        print(f"zenav {args.command}: {exc}", file=sys.stderr)
+        _say_each(f"zenav {args.command}", exc)
         return None
+
+
+def _say_each(command: str, exc: ConfigError) -> None:
+    """One line on stderr per problem (a ConfigError holds one per line)."""
+    for line in str(exc).splitlines():
+        print(f"{command}: {line}", file=sys.stderr)
 
 
 def cmd_up(args: argparse.Namespace) -> int:
@@ -79,7 +85,7 @@ def cmd_up(args: argparse.Namespace) -> int:
                                   "Left running: they join when it is; `zenav down` stops "
                                   "them")
     except ConfigError as exc:
-        print(f"zenav up: {exc}", file=sys.stderr)
+        _say_each("zenav up", exc)
         return 2
     except KeyboardInterrupt:
         print("zenav up: interrupted; what started is left running (`zenav down` stops it)",

@@ -10,7 +10,16 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from zenav.deploy.secure import PARTIES
 from zenav.schemas.keys import check_robot_id
-from zenav.services.config import SERVICE_ORDER, ConfigError, parse_assignment, read_yaml
+from zenav.services.config import (
+    SERVICE_ORDER,
+    ConfigError,
+    Layer,
+    assignment_layer,
+    file_layer,
+    parse_assignment,
+    read_yaml,
+    resolve,
+)
 from zenav.services.transport import TransportConfig
 from zenav.tooling import with_client_defaults
 
@@ -111,6 +120,32 @@ class Deployment(BaseModel):
         return self.services[program].service or program
 
 
+def check_program_params(deployment: Deployment, path: Path, overrides: list[str]) -> None:
+    """Validate the parameters of every zenav service program (its files, its ``set`` and
+    the command line's ``--set``) before anything starts: a bad one is a ConfigError with
+    one line per problem naming the flag or file, not a program restarting in a loop."""
+    from zenav.services.runner import service_params
+
+    problems = []
+    for program, spec in deployment.services.items():
+        if spec.command is not None:
+            continue
+        from_flags = {text.partition(".")[2] for text in overrides
+                      if text.partition(".")[0] == program}
+        layers = [file_layer(config) for config in spec.config]
+        for text in spec.set:
+            layer = assignment_layer(text)
+            source = (f"--set {program}.{text}" if text in from_flags
+                      else f"{path}: services.{program}.set: {text}")
+            layers.append(Layer(layer.origin, source, layer.values))
+        try:
+            resolve(service_params(deployment.service_of(program)), layers)
+        except ConfigError as exc:
+            problems.append(str(exc))
+    if problems:
+        raise ConfigError("\n".join(problems))
+
+
 def load_deployment(path: Path, overrides: Iterable[str] = (),
                     connect: list[str] | None = None,
                     scenario: Path | None = None) -> Deployment:
@@ -157,6 +192,7 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
                               f"of {', '.join(deployment.services)}")
         parse_assignment(assignment)  # reject a malformed one here, not in the service
         deployment.services[program].set.append(assignment)
+    check_program_params(deployment, path, list(overrides))
     if connect:
         deployment.transport = deployment.transport.model_copy(update={"connect": connect})
     deployment.transport = with_client_defaults(deployment.transport)
