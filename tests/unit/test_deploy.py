@@ -52,7 +52,7 @@ def test_supervisord_conf_restarts_on_failure_logs_per_program_and_stops_cleanly
     assert programs == ["router", "motor_bridge", "simulator", "laser_driver"]  # start order
     for name in programs:
         section = conf[f"program:{name}"]
-        assert section["autorestart"] == "unexpected" and section["exitcodes"] == "0"
+        assert section["autorestart"] == "unexpected" and section["exitcodes"] == "0,2"
         assert section["stopsignal"] == "TERM" and section["redirect_stderr"] == "true"
         assert section["stdout_logfile"] == str(tmp_path / "run" / "logs" / f"{name}.log")
         assert section["directory"] == str(tmp_path)
@@ -129,13 +129,13 @@ def test_a_bad_deployment_file_is_refused_naming_file_and_field(tmp_path, change
 
 def test_another_scenario_replaces_the_deployments_and_sets_the_derived_parameters(tmp_path):
     other = Path(__file__).resolve().parents[1] / "integration" / "data" / "offpath.yaml"
-    deployment = load_deployment(DEPLOY / "stack.yaml", ["simulator.seed_offset=1"],
+    deployment = load_deployment(DEPLOY / "stack.yaml", ["simulator.realtime_factor=4"],
                                  scenario=other)
     assert deployment.scenario == other
     conf = conf_of(prepare(deployment, tmp_path / "run", python="/py", workdir=tmp_path))
     simulator = shlex.split(conf["program:simulator"]["command"])
     sets = [simulator[i + 1] for i, a in enumerate(simulator) if a == "--set"]
-    assert sets == [f"scenario={other}", "seed_offset=1"]  # an explicit --set comes last
+    assert sets == [f"scenario={other}", "realtime_factor=4"]  # an explicit --set comes last
     planner = yaml.safe_load((tmp_path / "run" / "params" / "planner.scenario.yaml").read_text())
     assert planner["goal"] == [6.0, 4.0]
 

@@ -1,0 +1,167 @@
+"""The bad-input table: each mistake a user can make on the command line, the exit status
+and the one line that names it, before any process starts or any work is done.
+
+Every row runs the real ``zenav`` entry point in this process (nothing here opens a Zenoh
+session or starts a service). ``BAD_INPUT`` is the table itself; the report quotes it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+import yaml
+
+from zenav.bag.mcapfile import BagWriter
+from zenav.cli import main as zenav_main
+from zenav.schemas.codec import encode
+from zenav.schemas.messages import Odometry, Pose2D
+from zenav.sim.scenario import MAX_OBSTACLES
+
+REPO = Path(__file__).resolve().parents[2]
+SCENARIO = REPO / "sim" / "scenarios" / "a-no-obstacle.yaml"
+
+
+def scenario_with(tmp: Path, name: str, **changes: object) -> Path:
+    data = yaml.safe_load(SCENARIO.read_text())
+    for dotted, value in changes.items():
+        target = data
+        *parents, last = dotted.split("__")
+        for part in parents:
+            target = target[part]
+        target[last] = value
+    path = tmp / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def a_file(tmp: Path) -> Path:
+    path = tmp / "a-file"
+    path.write_text("not a folder\n")
+    return path
+
+
+def a_bag(tmp: Path) -> Path:
+    path = tmp / "run.mcap"
+    with path.open("wb") as stream:
+        writer = BagWriter(stream, "robot0")
+        odom = Odometry(stamp=0.1, seq=0, pose=Pose2D(x=1.0, y=2.0, heading=0.0), v=0.0,
+                        omega=0.0)
+        writer.add("zenav/robot0/odom", encode(odom), 1)
+        writer.close()
+    return path
+
+
+Args = Callable[[Path], list[str]]
+
+BAD_INPUT: list[tuple[str, Args, int, str]] = [
+    # (case, argv from a scratch folder, exit status, the first line of stderr)
+    ("run --out an existing file",
+     lambda t: ["run", str(SCENARIO), "--out", str(a_file(t))], 2,
+     "zenav run: {t}/a-file: exists and is not a folder"),
+    ("run --out a folder under a file",
+     lambda t: ["run", str(SCENARIO), "--out", str(a_file(t) / "out")], 2,
+     "zenav run: {t}/a-file/out: {t}/a-file is a file, not a folder"),
+    ("run --out in /proc", lambda t: ["run", str(SCENARIO), "--out", "/proc/zenav"], 2,
+     "zenav run: /proc/zenav: under /proc, which is not a place for output"),
+    ("paper --out an existing file", lambda t: ["paper", "--out", str(a_file(t))], 2,
+     "zenav paper: {t}/a-file: exists and is not a folder"),
+    ("bench nav --out in /sys", lambda t: ["bench", "nav", "--out", "/sys/zenav"], 2,
+     "zenav bench: /sys/zenav: under /sys, which is not a place for output"),
+    ("bench perf --out a folder under a file",
+     lambda t: ["bench", "perf", "--out", str(a_file(t) / "x")], 2,
+     "zenav bench: {t}/a-file/x: {t}/a-file is a file, not a folder"),
+    ("schemas --out an existing file", lambda t: ["schemas", "--out", str(a_file(t))], 2,
+     "zenav schemas: {t}/a-file: exists and is not a folder"),
+    ("record into a folder under a file",
+     lambda t: ["record", str(a_file(t) / "x.mcap"), "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav record: {t}/a-file/x.mcap: {t}/a-file is a file, not a folder"),
+    ("record onto a folder", lambda t: ["record", str(t), "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav record: {t}: is a folder, not a file"),
+    ("replay a file that is not MCAP",
+     lambda t: ["replay", str(a_file(t)), "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav replay: {t}/a-file: not an MCAP file (or cut short)"),
+    ("replay a missing file",
+     lambda t: ["replay", str(t / "none.mcap"), "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav replay: {t}/none.mcap: cannot read (No such file or directory)"),
+    ("replay --topics bogus",
+     lambda t: ["replay", str(a_bag(t)), "--topics", "odom,bogus",
+                "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav replay: --topics: bogus not in {t}/run.mcap (it has odom)"),
+    ("run --planner foo",
+     lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--planner", "foo"], 2,
+     "zenav run: --planner 'foo': no such planner; choose from paper, vfh, dwa, apf"),
+    ("run --set an unknown parameter",
+     lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--set", "perception.nosuch=1"],
+     2, "zenav run: --set perception.nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
+    ("run --set a bad value",
+     lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--set", "planner.cruise_speed=-1"],
+     2, "zenav run: --set planner.cruise_speed=-1: cruise_speed: Input should be greater "
+     "than 0 (got -1)"),
+    ("run --set an unknown service",
+     lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--set", "nosuch.x=1"], 2,
+     "zenav run: --set 'nosuch.x=1': expected SERVICE.NAME=VALUE with SERVICE one of "
+     "simulator, laser_driver, perception, tracking, planner, motor_bridge"),
+    ("run a scenario with 10,000 obstacles",
+     lambda t: ["run", str(scenario_with(t, "many", obstacles=[
+         {"shape": "disc", "center": [1.0, 1.0 + 1e-4 * i], "radius": 0.05}
+         for i in range(10_000)])), "--out", str(t / "o")], 2,
+     f"zenav run: {{t}}/many.yaml: obstacles: at most {MAX_OBSTACLES} obstacles (got 10000)"),
+    ("run a goal the robot disc cannot stand on",
+     lambda t: ["run", str(scenario_with(t, "goal", obstacles=[
+         {"shape": "box", "center": [8.35, 3.0], "size": [0.5, 0.5]}])), "--out", str(t / "o")],
+     2, "zenav run: {t}/goal.yaml: robot.goal: unreachable: the robot disc (radius 0.2 m) "
+     "at the goal overlaps static obstacles[0] (box, 0.1 m from the goal)"),
+    ("up --set an unknown parameter",
+     lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
+                str(REPO / "deploy" / "stack.yaml"), "--set", "planner.nosuch=1"], 2,
+     "zenav up: --set planner.nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
+    ("ctl status with nothing up",
+     lambda t: ["ctl", "--run-dir", str(t / "run"), "status"], 1,
+     "zenav ctl: run is not up ({t}/run); start it with `zenav up`"),
+    ("service --set an unknown parameter",
+     lambda t: ["service", "perception", "--set", "nosuch=1"], 2,
+     "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
+    ("params of an unknown planner", lambda t: ["params", "planner", "--planner", "foo"], 2,
+     "zenav params: no planner named 'foo'; the planners are paper, vfh, dwa, apf"),
+]
+
+
+@pytest.mark.parametrize(("argv", "code", "message"), [row[1:] for row in BAD_INPUT],
+                         ids=[row[0] for row in BAD_INPUT])
+def test_bad_input_is_one_line_and_a_status(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                            argv: Args, code: int, message: str) -> None:
+    tmp = tmp_path.resolve()
+    status = zenav_main(argv(tmp))
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert status == code, captured.err
+    assert lines == [message.format(t=tmp)], captured.err
+    assert "Traceback" not in captured.err + captured.out
+    assert not (tmp / "o" / "run.json").exists()
+
+
+def test_several_problems_in_one_scenario_are_one_line_each(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = scenario_with(tmp_path, "three", world__cell=0, robot__speed=0, robot__radius=-0.2)
+    assert zenav_main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"zenav run: {path}: world.cell: must be > 0 (got 0)",
+        f"zenav run: {path}: robot.speed: must be > 0 (got 0)",
+        f"zenav run: {path}: robot.radius: must be > 0 (got -0.2)",
+    ]
+
+
+def test_schemas_without_out_prints_every_schema_and_writes_nothing(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import json
+
+    from zenav.schemas.messages import ALL_MESSAGES
+
+    monkeypatch.chdir(tmp_path)
+    assert zenav_main(["schemas"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert set(printed) == {m.TYPE for m in ALL_MESSAGES}
+    assert list(tmp_path.iterdir()) == []
