@@ -5,6 +5,7 @@ function ``main`` calls with the parsed arguments."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -41,9 +42,16 @@ def main(argv: list[str] | None = None) -> int:
     """The command's exit status; SIGINT at any point (even while the modules load) ends it
     quietly with 130, as a shell expects."""
     try:
-        return _main(argv)
+        code = _main(argv)
     except KeyboardInterrupt:
-        return 130
+        code = 130
+    from zenav.tooling import still_opening
+
+    if still_opening():  # stopped while connecting: skip a teardown that stalls for seconds
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 def _main(argv: list[str] | None) -> int:

@@ -93,6 +93,17 @@ def connect_problem(transport: TransportConfig, timeout: float, exc: BaseExcepti
     return f"cannot open a Zenoh {transport.mode} session within {timeout:g} s{detail}"
 
 
+_OPENING: set[threading.Thread] = set()
+"""Threads still inside ``zenoh.open`` (a tool stopped while it was connecting)."""
+
+
+def still_opening() -> bool:
+    """Whether a session is still being opened in a thread no one waits for. The
+    interpreter's own exit then stalls for seconds in Zenoh's native teardown; the
+    ``zenav`` command ends such a process with ``os._exit`` instead (after flushing)."""
+    return any(thread.is_alive() for thread in _OPENING)
+
+
 WAITING_NOTE_AFTER = 1.0
 """s after which a tool still connecting says on stderr what it waits for."""
 
@@ -129,6 +140,8 @@ async def open_bus(transport: TransportConfig, stop: asyncio.Event,
             session = zenoh.open(conf)
         except Exception as exc:  # handed to the loop
             error = exc
+        finally:
+            _OPENING.discard(threading.current_thread())
         try:
             loop.call_soon_threadsafe(deliver, session, error)
         except RuntimeError:  # the loop is closed: the tool stopped meanwhile
@@ -136,7 +149,9 @@ async def open_bus(transport: TransportConfig, stop: asyncio.Event,
                 with contextlib.suppress(Exception):
                     session.close()
 
-    threading.Thread(target=work, name="zenav-open", daemon=True).start()
+    opener = threading.Thread(target=work, name="zenav-open", daemon=True)
+    _OPENING.add(opener)
+    opener.start()
     stopped = asyncio.ensure_future(stop.wait())
     try:
         if command is not None and transport.mode == "client" and timeout > WAITING_NOTE_AFTER:

@@ -89,7 +89,7 @@ def main(args: argparse.Namespace) -> int:
             if done is None:
                 print("zenav record: stopped before the session opened; nothing recorded",
                       file=sys.stderr)
-                return 1
+                return 0
             count, changes = done
             print(f"zenav record: {count} messages and {changes} liveliness changes in "
                   f"{time.monotonic() - started:.1f} s -> {args.file} "
