@@ -84,13 +84,20 @@ class Service:
         self._alive_changed.set()
 
     async def wait_for_stack(self) -> None:
-        deadline = time.monotonic() + self.params.startup_timeout
+        """Until every service of ``wait_for`` is alive. The timeout is a wait for the
+        *next* one: it starts again each time another arrives, so a loaded machine that
+        starts services slowly but steadily is waited for, and a stuck one is named."""
+        timeout = self.params.startup_timeout
+        deadline = time.monotonic() + timeout
+        waiting = set(self.params.wait_for)
         while missing := set(self.params.wait_for) - self._alive:
+            if missing < waiting:  # progress: another one is up
+                waiting, deadline = missing, time.monotonic() + timeout
             left = deadline - time.monotonic()
             if left <= 0:
                 raise StackSilentError(
-                    f"services not up after {self.params.startup_timeout:.0f} s: "
-                    f"{', '.join(sorted(missing))}"
+                    f"services not up after {timeout:.0f} s without another arriving; still "
+                    f"waiting on {', '.join(sorted(missing))}"
                 )
             self._alive_changed.clear()
             try:

@@ -32,7 +32,8 @@ class Params(BaseModel):
         default_factory=lambda: list(LIVE_SERVICES),
         description="services whose liveliness is awaited before the clock starts",
     )
-    startup_timeout: float = Field(60.0, gt=0, description="wall s to wait for them")
+    startup_timeout: float = Field(60.0, gt=0, description="wall s to wait for the next of "
+                                   "them to arrive (starts again at each arrival)")
     retransmit_after: float = Field(0.5, gt=0, description="wall s before a frame is resent")
     answer_timeout: float = Field(30.0, gt=0, description="wall s without an answer: fail")
     result_repeat: float = Field(0.5, gt=0, description="wall s between result repeats")

@@ -3,7 +3,9 @@ kill -9, ...), printed in a section of pytest's summary so that they can be quot
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -39,3 +41,25 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
         terminalreporter.section("zenav measurements")
         for line in MEASURED:
             terminalreporter.write_line(line)
+
+
+BUSY_LOOPS = 2
+"""CPU burners a loaded-machine test runs beside the stack (one per core here)."""
+
+
+@pytest.fixture
+def busy_machine() -> Iterator[list[subprocess.Popen[bytes]]]:
+    """Two busy-loop processes for the length of the test: recovery figures taken on a
+    machine that has other work to do. Each ends by itself after 15 minutes, should the
+    test's own teardown never run."""
+    burners = [subprocess.Popen([sys.executable, "-c",
+                                 "import time\nend = time.monotonic() + 900\n"
+                                 "while time.monotonic() < end: pass"],
+                                stdin=subprocess.DEVNULL)
+               for _ in range(BUSY_LOOPS)]
+    try:
+        yield burners
+    finally:
+        for burner in burners:
+            burner.kill()
+            burner.wait(timeout=10)

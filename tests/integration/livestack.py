@@ -71,7 +71,7 @@ class Deployed:
     def supervisor(self) -> Supervisor:
         return Supervisor(self.run_dir)
 
-    def up(self, timeout: float = 40) -> subprocess.CompletedProcess[str]:
+    def up(self, timeout: float = 240) -> subprocess.CompletedProcess[str]:
         done = run([*self.prefix, *zenav("up", "--config", str(self.config), "--run-dir",
                                          str(self.run_dir), *self.up_args)], timeout=timeout + 10)
         self.is_up = self.supervisor.pid() is not None

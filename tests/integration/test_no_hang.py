@@ -139,9 +139,10 @@ def test_up_says_which_services_it_still_waits_on_when_the_router_is_missing(
         lines = done.stderr.splitlines()
         assert done.returncode == 2, done.stderr
         assert len(lines) == 1, done.stderr
-        assert lines[0].startswith("zenav up: running, but still waiting on perception, "
-                                   f"planner, tracking on the bus after 8 s (is the router at "
-                                   f"{endpoint} reachable?)"), lines
+        assert lines[0].startswith(
+            "zenav up: running, but still waiting on perception, planner, tracking on the "
+            f"bus after 8 s without another arriving (is the router at {endpoint} "
+            "reachable?)"), lines
     finally:
         stack.cleanup()
 

@@ -80,7 +80,8 @@ def cmd_up(args: argparse.Namespace) -> int:
             if missing:
                 check_started(sup, programs)
                 raise ConfigError(f"running, but still waiting on {', '.join(sorted(missing))} "
-                                  f"on the bus after {args.timeout:.0f} s (is the router at "
+                                  f"on the bus after {args.timeout:.0f} s without another "
+                                  f"arriving (is the router at "
                                   f"{', '.join(deployment.transport.connect)} reachable?). "
                                   "Left running: they join when it is; `zenav down` stops "
                                   "them")
@@ -165,7 +166,9 @@ def add_commands(sub: Any) -> None:
     up.add_argument("--scenario", type=Path,
                     help="the simulator's scenario (replaces the deployment's; the "
                     "parameters that follow from it are derived from this one)")
-    up.add_argument("--timeout", type=float, default=30.0, help="s to wait (default 30)")
+    up.add_argument("--timeout", type=float, default=30.0,
+                    help="s to wait for the next program to run and to join the bus; "
+                    "starts again at each one (default 30)")
     up.add_argument("--no-wait", action="store_true",
                     help="do not wait for the liveliness tokens")
     up.add_argument("--print", action="store_true",

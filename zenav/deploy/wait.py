@@ -50,31 +50,37 @@ def check_started(sup: Supervisor, programs: list[str]) -> None:
 
 
 def wait_running(sup: Supervisor, programs: list[str], timeout: float) -> None:
-    """Until every program is RUNNING; one that exits or fails raises ConfigError."""
+    """Until every program is RUNNING; one that exits or fails raises ConfigError. The
+    ``timeout`` is for the next one: it starts again each time another runs."""
     deadline = time.monotonic() + timeout
+    left_over = len(programs)
     while True:
         check_started(sup, programs)
         infos = sup.processes()
         waiting = [p for p in programs if infos.get(p, {}).get("statename") != "RUNNING"]
         if not waiting:
             return
+        if len(waiting) < left_over:
+            left_over, deadline = len(waiting), time.monotonic() + timeout
         if time.monotonic() > deadline:
             states = ", ".join(f"{p} {infos.get(p, {}).get('statename', '?')}" for p in waiting)
-            raise ConfigError(f"not running after {timeout:.0f} s: {states}")
+            raise ConfigError(f"not running after {timeout:.0f} s without another starting; "
+                              f"still waiting on {states}")
         time.sleep(0.1)
 
 
 def wait_alive(deployment: Deployment, services: set[str], timeout: float,
                check: Callable[[], None] = lambda: None) -> set[str]:
     """Services among ``services`` whose liveliness token is not on the bus after
-    ``timeout`` s (empty when all are). ``check`` is called every ``CHECK_EVERY`` s
-    meanwhile and may raise (a program that exited)."""
+    ``timeout`` s without another arriving (empty when all are): the wait starts again
+    at each arrival. ``check`` is called every ``CHECK_EVERY`` s meanwhile and may raise
+    (a program that exited)."""
     transport = deployment.transport
     if deployment.security is not None:  # zenav up watches with the monitor's certificate
         transport = secured_transport(deployment, "monitor")
     transport = with_connect_timeout(transport, timeout)
     return asyncio.run(_missing_tokens(transport, Keys(deployment.robot_id), services,
-                                       time.monotonic() + timeout, check))
+                                       timeout, check))
 
 
 CHECK_EVERY = 0.25
@@ -82,11 +88,10 @@ CHECK_EVERY = 0.25
 
 
 async def _missing_tokens(transport: TransportConfig, keys: Keys, services: set[str],
-                          deadline: float, check: Callable[[], None]) -> set[str]:
+                          timeout: float, check: Callable[[], None]) -> set[str]:
     stop = asyncio.Event()
     stop_on_signals(stop)
-    left = max(0.1, deadline - time.monotonic())
-    opening = asyncio.ensure_future(open_bus(transport, stop, left))
+    opening = asyncio.ensure_future(open_bus(transport, stop, timeout))
     try:
         while not opening.done():
             check()
@@ -106,9 +111,14 @@ async def _missing_tokens(transport: TransportConfig, keys: Keys, services: set[
             missing.discard(key.rsplit("/", 1)[-1])
             seen.set()
 
+    deadline = time.monotonic() + timeout
+    left_over = len(missing)
     try:
         bus.watch_liveliness(keys.alive_any, on_liveliness)
         while missing and (left := deadline - time.monotonic()) > 0:
+            if len(missing) < left_over:  # another one arrived: wait for the next afresh
+                left_over, deadline = len(missing), time.monotonic() + timeout
+                continue
             if stop.is_set():
                 raise KeyboardInterrupt
             check()

@@ -1,0 +1,141 @@
+"""A newcomer's walk through the README: the commands of its quick start, of "Running
+services by hand" and of its deployment sections, typed as the README gives them to the
+installed ``zenav`` command, each judged on its exit status and its first line of output.
+
+Two liberties, both for a shared machine: the deployment gets a free router port and a
+run directory of its own (the README's ``zenav up`` uses 7447 and ~/.local/state), and the
+by-hand stack is checked on what its services would read rather than run in real time.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.integration.livestack import REPO, copy_deployment
+from zenav.launch import free_port_block
+
+pytestmark = pytest.mark.integration
+
+ZENAV = str(Path(sys.executable).with_name("zenav"))
+"""The command pip installed beside this interpreter, as the README calls it."""
+
+SCENARIO = "sim/scenarios/a-no-obstacle.yaml"
+
+
+def zenav(*args: str, timeout: float = 240) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([ZENAV, *args], capture_output=True, text=True, timeout=timeout,
+                          cwd=REPO, check=False, stdin=subprocess.DEVNULL)
+
+
+def first_line(text: str) -> str:
+    return text.splitlines()[0] if text.strip() else ""
+
+
+def test_quick_start_runs_a_scenario_and_leaves_its_record(tmp_path: Path) -> None:
+    out = tmp_path / "a-no-obstacle"
+    done = zenav("run", SCENARIO, "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    assert first_line(done.stdout).startswith("a-no-obstacle: reached at t=57.60 s, "), done.stdout
+    record = json.loads((out / "run.json").read_text())
+    assert record["outcome"] == "reached"
+    assert (out / "run.png").is_file()
+    assert {p.stem for p in (out / "params").glob("*.yaml")} >= {"planner", "simulator"}
+    assert {p.stem for p in (out / "logs").glob("*.log")} >= {"planner", "simulator"}
+
+
+def test_params_commands_print_every_parameter_with_its_origin() -> None:
+    done = zenav("params", "perception")
+    assert done.returncode == 0, done.stderr
+    assert first_line(done.stdout) == ("# perception: every parameter, its value and its "
+                                       "origin (zenav params perception)")
+    done = zenav("params", "planner", "--scenario", SCENARIO, "--set", "heading_gain=2")
+    assert done.returncode == 0, done.stderr
+    assert f"cruise_speed: 0.1  # scenario {SCENARIO}" in done.stdout
+    assert "heading_gain: 2.0  # --set" in done.stdout
+
+
+def test_a_service_started_by_hand_stops_on_sigint_within_a_second() -> None:
+    proc = subprocess.Popen([ZENAV, "service", "perception", "--config",
+                             "deploy/params/perception.yaml", "--base-port",
+                             str(free_port_block(6))],
+                            cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            stdin=subprocess.DEVNULL)
+    try:
+        time.sleep(8)  # imports and session: seconds on a loaded machine
+        assert proc.poll() is None, proc.communicate()[1]
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        code = proc.wait(timeout=10)
+        assert time.monotonic() - sent < 1.0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert code == 0
+
+
+def test_the_by_hand_stack_drives_to_the_scenarios_goal(tmp_path: Path) -> None:
+    """The README's loop writes each service's scenario parameters, then starts it with
+    them under deploy/params: the planner must read the scenario's goal, not (6, 0)."""
+    for service in ("laser_driver", "perception", "tracking", "planner", "motor_bridge"):
+        done = zenav("params", service, "--scenario", SCENARIO)
+        assert done.returncode == 0, done.stderr
+        (tmp_path / f"{service}.yaml").write_text(done.stdout)
+        check = zenav("params", service, "--params", str(tmp_path / f"{service}.yaml"),
+                      "--params", f"deploy/params/{service}.yaml")
+        assert check.returncode == 0, check.stderr
+    planner = zenav("params", "planner", "--params", str(tmp_path / "planner.yaml"),
+                    "--params", "deploy/params/planner.yaml")
+    assert f"goal: [8.0, 3.0]  # file {tmp_path / 'planner.yaml'}" in planner.stdout
+
+
+def test_schemas_go_where_the_readme_says(tmp_path: Path) -> None:
+    done = zenav("schemas", "--out", str(tmp_path / "json"))
+    assert done.returncode == 0, done.stderr
+    assert first_line(done.stdout).startswith(str(tmp_path / "json") + "/")
+    printed = zenav("schemas")
+    assert printed.returncode == 0 and json.loads(printed.stdout), printed.stderr
+
+
+def test_one_host_deployment_up_status_monitor_record_replay_down(tmp_path: Path) -> None:
+    endpoint = f"tcp/127.0.0.1:{free_port_block(1)}"
+    config = copy_deployment(REPO / "deploy" / "stack.yaml", tmp_path / "stack.yaml",
+                             scenario=str(REPO / SCENARIO), router={"listen": [endpoint]},
+                             transport={"mode": "client", "connect": [endpoint]})
+    where = ["--config", str(config), "--run-dir", str(tmp_path / "run")]
+    try:
+        up = zenav("up", *where)
+        assert up.returncode == 0, up.stderr
+        assert first_line(up.stdout).startswith(
+            "zenav up: stack: router, simulator, laser_driver, perception, tracking, planner, "
+            "motor_bridge running and alive on the bus; logs in "), up.stdout
+        status = zenav("ctl", *where, "status")
+        assert status.returncode == 0, status.stderr
+        assert first_line(status.stdout).split()[:2] == ["laser_driver", "RUNNING"]
+        monitor = zenav("monitor", "--connect", endpoint, "--jsonl", "--duration", "4")
+        assert monitor.returncode == 0, monitor.stderr
+        assert json.loads(first_line(monitor.stdout))["event"] in ("snapshot", "alive", "flow")
+        bag = tmp_path / "run.mcap"
+        record = zenav("record", str(bag), "--connect", endpoint, "--duration", "4")
+        assert record.returncode == 0, record.stderr
+        assert first_line(record.stdout) == f"zenav record: recording zenav/robot0/** to {bag}"
+        replay = zenav("replay", str(bag), "--topics", "odom", "--rate", "4",
+                       "--as-robot", "newcomer", "--connect", endpoint)
+        assert replay.returncode == 0, replay.stderr
+        assert first_line(replay.stdout).startswith("zenav replay: "), replay.stdout
+        assert " messages in " in replay.stdout
+    finally:
+        down = zenav("down", *where)
+    assert down.returncode == 0, down.stderr
+    assert first_line(down.stdout) == "zenav down: stack stopped cleanly"
+    after = zenav("ctl", *where, "status")
+    assert after.returncode == 1
+    assert first_line(after.stderr) == (f"zenav ctl: stack is not up ({tmp_path / 'run'}); "
+                                        "start it with `zenav up`")
