@@ -360,13 +360,6 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
     for i, obstacle in enumerate(scenario.obstacles):
         if count > MAX_OBSTACLES:
             break  # the count is the problem; one line, not a thousand
-        for field, extent in (("size", obstacle.size), ("radius", obstacle.radius)):
-            if extent is None:
-                continue
-            largest = max(extent) if isinstance(extent, tuple) else 2 * extent
-            if largest > max(width, height):
-                problems.append(((f"obstacles[{i}]", field), f"larger than the world "
-                                 f"({largest:g} m across, world {width:g} x {height:g} m)"))
         forever = obstacle.appear <= 0.0 and obstacle.vanish is None
         if not (obstacle.is_static and forever):
             continue

@@ -8,7 +8,6 @@ import argparse
 import os
 import sys
 
-
 LIGHT = ("service", "router")
 """Commands a supervisor restarts after a crash: their parser is built alone, without
 importing every other command (the benchmarks pull in scipy and matplotlib), because a

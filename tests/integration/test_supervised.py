@@ -46,6 +46,8 @@ OUTPUT = {
 robot side's odometry reaching the monitor again."""
 
 
+LONGER_SCENARIO = LONG_SCENARIO.with_name("longer.yaml")
+
 LOADED_WAIT = 90.0
 """s any one step of the loaded kill -9 test may take: with two busy loops beside a
 shared 2-core machine, a Python service's restart alone can take tens of seconds."""
@@ -65,16 +67,17 @@ def has_tracks_after(since: float) -> Callable[[Event], bool]:
     return check
 
 
-def one_host(tmp_path: Path, timeout: float = 30, **changes: object) -> tuple[Deployed, str]:
-    """deploy/stack.yaml on a free loopback port, on the long scenario, at 2x real time;
-    ``timeout`` is zenav up's wait for each next program."""
+def one_host(tmp_path: Path, timeout: float = 30, speed: float = 2.0,
+             scenario: Path = LONG_SCENARIO, **changes: object) -> tuple[Deployed, str]:
+    """deploy/stack.yaml on a free loopback port, on ``scenario``, at ``speed`` x real
+    time; ``timeout`` is zenav up's wait for each next program."""
     endpoint = f"tcp/127.0.0.1:{free_port_block(1)}"
     config = copy_deployment(
-        REPO / "deploy" / "stack.yaml", tmp_path / "stack.yaml", scenario=str(LONG_SCENARIO),
+        REPO / "deploy" / "stack.yaml", tmp_path / "stack.yaml", scenario=str(scenario),
         router={"listen": [endpoint]}, transport={"mode": "client", "connect": [endpoint]},
         **changes)
     return Deployed(config, tmp_path / "run",
-                    up_args=["--set", "simulator.realtime_factor=2", "--timeout",
+                    up_args=["--set", f"simulator.realtime_factor={speed:g}", "--timeout",
                              str(timeout)]), endpoint
 
 
@@ -111,9 +114,13 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
         tmp_path, measure, busy_machine):
     """Measured with two busy loops running (``busy_machine``): recovery must not depend
     on a quiet machine."""
-    stack, endpoint = one_host(tmp_path, timeout=LOADED_WAIT)
+    # Real time on the 28 m run: while an upstream service restarts (seconds, on a busy
+    # machine) the robot goes on with the last tracks, and it must still be under way
+    # for the last kill.
+    stack, endpoint = one_host(tmp_path, timeout=LOADED_WAIT, speed=1.0,
+                               scenario=LONGER_SCENARIO)
     monitor = None
-    start_x = load_scenario(LONG_SCENARIO).robot.start[0]
+    start_x = load_scenario(LONGER_SCENARIO).robot.start[0]
     times: dict[str, dict[str, float]] = {}
     try:
         stack.up()
@@ -141,6 +148,10 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
                                     topic=output, flowing=True)
             times[program] = {"spawned": spawned - killed, "alive": back["wall"] - killed,
                               "flowing": flowing["wall"] - killed}
+            measure(f"kill -9 {program}, {len(busy_machine)} busy loops -> data flowing "
+                    f"again ({output})", times[program]["flowing"],
+                    f"respawned {times[program]['spawned']:.3f} s, liveliness back "
+                    f"{times[program]['alive']:.3f} s")
             after = stack.pids()
             assert after[program] == pid
             assert {p: after[p] for p in after if p != program} == \
@@ -149,7 +160,7 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
                 monitor.state("tracks again after the restart",
                               has_tracks_after(flowing["wall"]), timeout=LOADED_WAIT)
             x = snap["truth"]["x"] + 0.1
-        final = monitor.state("the run's result", reached, timeout=3 * LOADED_WAIT)
+        final = monitor.state("the run's result", reached, timeout=6 * LOADED_WAIT)
         assert final["result"]["outcome"] == "reached", final["result"]
         assert final["result"]["collided_with"] is None
         rejoins = {name: s["rejoins"] for name, s in final["services"].items()}
@@ -161,10 +172,6 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
         stopped = stack.down() if stack.is_up else None
         stack.cleanup()
     assert stopped is not None and stopped.returncode == 0, stopped
-    for program, t in times.items():
-        measure(f"kill -9 {program}, {len(busy_machine)} busy loops -> data flowing again "
-                f"({OUTPUT[program]})", t["flowing"],
-                f"respawned {t['spawned']:.3f} s, liveliness back {t['alive']:.3f} s")
     # The target is 1 s; this bound only catches a recovery that does not happen (the
     # figures above are the result, and depend on how busy the machine is besides).
     assert all(t["flowing"] < LOADED_WAIT for t in times.values()), times
