@@ -24,8 +24,8 @@ from zenav.services.ros2.node import Ros2Node
 from zenav.services.ros2.view import tracks_to_markers
 from zenav.services.ros2.wire import MARKER_ARRAY, WireError, qualify
 from zenav.services.runner import add_transport_arguments
-from zenav.services.transport import Bus, ZenohBus
-from zenav.tooling import stop_on_signals, tool_setup
+from zenav.services.transport import Bus
+from zenav.tooling import ConnectError, add_connect_timeout, open_bus, stop_on_signals, tool_setup
 
 
 class RvizView:
@@ -77,7 +77,9 @@ class RvizView:
 async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None:
     stop = asyncio.Event()
     stop_on_signals(stop)
-    bus = ZenohBus(transport, asyncio.get_running_loop())
+    bus = await open_bus(transport, stop, args.connect_timeout, "zenav rviz")
+    if bus is None:  # stopped while connecting
+        return
     view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame)
     task = asyncio.get_running_loop().create_task(view.run())
     try:
@@ -100,8 +102,12 @@ def main(args: argparse.Namespace) -> int:
         print(f"zenav rviz: --topic: {exc}", file=sys.stderr)
         return 2
     robot_id, transport = setup
-    with contextlib.suppress(KeyboardInterrupt):
-        asyncio.run(serve(transport, robot_id, args))
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            asyncio.run(serve(transport, robot_id, args))
+    except ConnectError as exc:
+        print(f"zenav rviz: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -114,4 +120,5 @@ def add_command(sub: Any) -> None:
     rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
     rviz.add_argument("--frame", default="odom", help="frame of zenav's poses (default odom)")
     add_transport_arguments(rviz)
+    add_connect_timeout(rviz)
     rviz.set_defaults(func=main)

@@ -55,6 +55,8 @@ TOOLS: dict[str, Callable[[Path], list[str]]] = {
     "monitor": lambda tmp: ["monitor", "--jsonl"],
     "record": lambda tmp: ["record", str(tmp / "out.mcap")],
     "replay": lambda tmp: ["replay", str(a_bag(tmp))],
+    "foxglove": lambda tmp: ["foxglove", "--port", "0"],
+    "rviz": lambda tmp: ["rviz"],
 }
 
 
@@ -100,7 +102,7 @@ def _stderr_lines(proc: subprocess.Popen[str]) -> queue.Queue[str]:
 
 @pytest.mark.parametrize(("tool", "signum"), [
     ("monitor", signal.SIGINT), ("monitor", signal.SIGTERM), ("record", signal.SIGINT),
-    ("replay", signal.SIGTERM)])
+    ("replay", signal.SIGTERM), ("foxglove", signal.SIGINT), ("rviz", signal.SIGTERM)])
 def test_a_tool_waiting_for_its_router_stops_at_once_on_a_signal(
         tool: str, signum: signal.Signals, tmp_path: Path,
         measure: Callable[[str, float, str], None]) -> None:

@@ -21,8 +21,15 @@ from foxglove import channels
 from zenav.foxglove.recording import SampleConverter
 from zenav.foxglove.scene import TOPICS
 from zenav.services.runner import add_transport_arguments
-from zenav.services.transport import ZenohBus
-from zenav.tooling import StampedSubscriber, stop_on_signals, tool_setup
+from zenav.tooling import (
+    CONNECT_TIMEOUT,
+    ConnectError,
+    StampedSubscriber,
+    add_connect_timeout,
+    open_bus,
+    stop_on_signals,
+    tool_setup,
+)
 
 
 class LiveChannels:
@@ -44,7 +51,8 @@ class LiveChannels:
 
 
 async def serve(transport: Any, robot_id: str, host: str, port: int,
-                duration: float | None = None) -> None:
+                duration: float | None = None,
+                connect_timeout: float = CONNECT_TIMEOUT) -> None:
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     stop_on_signals(stop)
@@ -53,7 +61,10 @@ async def serve(transport: Any, robot_id: str, host: str, port: int,
     live = LiveChannels(robot_id)
     server = foxglove.start_server(name=f"zenav {robot_id}", host=host, port=port,
                                    context=live.context)
-    bus = ZenohBus(transport, loop)
+    bus = await open_bus(transport, stop, connect_timeout, "zenav foxglove")
+    if bus is None:  # stopped while connecting
+        server.stop()
+        return
     subscriber = StampedSubscriber(bus, live.converter.keys.everything, live.add)
     print(f"zenav foxglove: serving {live.converter.keys.everything} on "
           f"ws://{host}:{server.port}", flush=True)
@@ -75,7 +86,11 @@ def main(args: argparse.Namespace) -> int:
     robot_id, transport = setup
     try:
         with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(serve(transport, robot_id, args.host, args.port, args.duration))
+            asyncio.run(serve(transport, robot_id, args.host, args.port, args.duration,
+                              args.connect_timeout))
+    except ConnectError as exc:  # before RuntimeError, of which it is a subclass
+        print(f"zenav foxglove: {exc}", file=sys.stderr)
+        return 1
     except RuntimeError as exc:  # the SDK's server could not bind
         print(f"zenav foxglove: {exc}", file=sys.stderr)
         return 1
@@ -94,4 +109,5 @@ def add_command(sub: Any) -> None:
     parser.add_argument("--port", type=int, default=8765, help="WebSocket port (default 8765)")
     parser.add_argument("--duration", type=float, help="stop after this many s")
     add_transport_arguments(parser)
+    add_connect_timeout(parser)
     parser.set_defaults(func=main)
