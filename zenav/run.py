@@ -136,13 +136,13 @@ async def _collect(stack: Stack, progress_timeout: float,
         # The wait is for the next service: it starts again at each arrival, so a slow
         # but steady start on a busy machine is not a failure.
         deadline = time.monotonic() + progress_timeout
-        seen = 0
+        arrived = 0
         while not everyone.is_set():
             failure = stack.failure()
             if failure:
                 raise RunError(failure)
-            if len(alive) > seen:
-                seen, deadline = len(alive), time.monotonic() + progress_timeout
+            if len(alive) > arrived:
+                arrived, deadline = len(alive), time.monotonic() + progress_timeout
             if time.monotonic() > deadline:
                 missing = ", ".join(sorted(set(stack.services) - alive))
                 raise RunError(f"services not reachable after {progress_timeout:.0f} s without "

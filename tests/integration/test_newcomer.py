@@ -109,7 +109,9 @@ def test_one_host_deployment_up_status_monitor_record_replay_down(tmp_path: Path
     config = copy_deployment(REPO / "deploy" / "stack.yaml", tmp_path / "stack.yaml",
                              scenario=str(REPO / SCENARIO), router={"listen": [endpoint]},
                              transport={"mode": "client", "connect": [endpoint]})
-    where = ["--config", str(config), "--run-dir", str(tmp_path / "run")]
+    # The run directory named as the README's default (~/.local/state/zenav/stack), so
+    # that down and ctl, which go by the directory, name the stack as there.
+    where = ["--config", str(config), "--run-dir", str(tmp_path / "stack")]
     try:
         up = zenav("up", *where)
         assert up.returncode == 0, up.stderr
@@ -137,5 +139,5 @@ def test_one_host_deployment_up_status_monitor_record_replay_down(tmp_path: Path
     assert first_line(down.stdout) == "zenav down: stack stopped cleanly"
     after = zenav("ctl", *where, "status")
     assert after.returncode == 1
-    assert first_line(after.stderr) == (f"zenav ctl: stack is not up ({tmp_path / 'run'}); "
+    assert first_line(after.stderr) == (f"zenav ctl: stack is not up ({tmp_path / 'stack'}); "
                                         "start it with `zenav up`")
