@@ -98,13 +98,16 @@ def test_bad_scenario_fails_with_one_line_naming_file_and_field(tmp_path):
     assert not (tmp_path / "out" / "run.json").exists()
 
 
-def test_a_service_that_fails_to_start_ends_the_run_with_its_reason(tmp_path):
+def test_a_parameter_a_service_would_refuse_ends_the_run_before_it_starts(tmp_path):
+    """Once a service that failed at start (exit 1, its log's reason); now the --set is
+    checked against the service's parameters before any process starts."""
     done = zenav("run", str(SCENARIOS / "a-no-obstacle.yaml"), "--out", str(tmp_path),
                  "--set", "perception.window_radius=-1", timeout=60)
-    assert done.returncode == 1
-    line = done.stderr.strip()
-    assert "\n" not in line
-    assert "perception" in line and "window_radius" in line
+    assert done.returncode == 2
+    assert done.stderr.splitlines() == [
+        "zenav run: --set perception.window_radius=-1: window_radius: Input should be "
+        "greater than 0 (got -1)"]
+    assert not (tmp_path / "logs").exists()  # nothing was started
 
 
 def test_a_service_that_dies_mid_run_ends_the_run_without_a_hang(tmp_path):
