@@ -17,6 +17,7 @@ from zenav.bag.mcapfile import BagWriter
 from zenav.cli import main as zenav_main
 from zenav.schemas.codec import encode
 from zenav.schemas.messages import Odometry, Pose2D
+from zenav.services.runner import PLANNERS
 from zenav.sim.scenario import MAX_OBSTACLES
 
 REPO = Path(__file__).resolve().parents[2]
@@ -91,7 +92,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      "zenav replay: --topics: bogus not in {t}/run.mcap (it has odom)"),
     ("run --planner foo",
      lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--planner", "foo"], 2,
-     "zenav run: --planner 'foo': no such planner; choose from paper, vfh, dwa, apf"),
+     f"zenav run: --planner 'foo': no such planner; choose from {', '.join(PLANNERS)}"),
     ("run --set an unknown parameter",
      lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--set", "perception.nosuch=1"],
      2, "zenav run: --set perception.nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
@@ -124,7 +125,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["service", "perception", "--set", "nosuch=1"], 2,
      "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
     ("params of an unknown planner", lambda t: ["params", "planner", "--planner", "foo"], 2,
-     "zenav params: no planner named 'foo'; the planners are paper, vfh, dwa, apf"),
+     f"zenav params: no planner named 'foo'; the planners are {', '.join(PLANNERS)}"),
 ]
 
 
