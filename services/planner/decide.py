@@ -268,6 +268,33 @@ class Planner:
             end = d
         return end
 
+    def _mapped(self, a: Assessment, stamp: float) -> bool:
+        """Whether a standing obstacle has been seen long enough to be in the map."""
+        seen = stamp - self.first_seen.get(a.obstacle.id, stamp)
+        return self.costmap is not None and seen >= self.p.map_confirm + 0.5
+
+    def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
+        """Beyond the paper: whether the straight way to ``target`` is free on the map's
+        fine, inflated grid. The paper's (b) test reads an obstacle's cell box S_k (0.5 m
+        cells), which can close a 1 m gap between two walls; an obstacle the map has
+        confirmed is judged on the map instead. ``to_goal``: the way is checked as far
+        as the (b) test looks, past the look-ahead point along the path."""
+        if self.costmap is None or not self.p.use_map:
+            return False
+        offset = target - robot
+        distance = float(np.hypot(*offset))
+        if distance < 1e-9:
+            return True
+        direction = offset / distance
+        length = distance
+        if to_goal:
+            length = max(distance, min(self._straight_ahead(robot, direction),
+                                       self.p.window_radius))
+        first = min(self.p.map_resolution, length)
+        samples = path_points(robot + direction * first, direction, length - first,
+                              self.p.map_resolution / 2)
+        return not bool(self.costmap.blocked_at(samples).any())
+
     # -- responses ---------------------------------------------------------------------
 
     def crossing_response(self, a: Assessment, committed: Action | None) -> tuple[Action, float]:
@@ -495,8 +522,11 @@ class Planner:
         notes = self._assess_all(robot, target, in_window, slack, to_goal=self.detour is None)
         # A "new" obstacle has been seen once: it is answered from the next scan on, when
         # its type is known (the motor bridge's stop zone covers the meantime).
+        # On a detour the paper's boxes decide, as in the paper; on the path the map may.
+        clear = self.detour is None and self._map_clear(robot, target, to_goal=True)
         threats = [self._sticky(a) for a in notes
-                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)]
+                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
+                   and not (a.letter == "b" and clear and self._mapped(a, stamp))]
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
