@@ -247,6 +247,10 @@ class Obstacle(BaseModel):
     moved: float = Field(
         0.0, ge=0.0, le=1.0, description="free-space motion score (0 = stood still)"
     )
+    moved_each: list[tuple[NonNegative, float]] = Field(
+        default_factory=list, max_length=8,
+        description="the motion score against each earlier scan compared with: (its stamp, "
+        "score); a tracker ignores those taken before the obstacle was first seen")
 
 
 class ObstacleChain(Message):
