@@ -269,9 +269,18 @@ class Planner:
         return end
 
     def _mapped(self, a: Assessment, stamp: float) -> bool:
-        """Whether a standing obstacle has been seen long enough to be in the map."""
+        """Whether a standing obstacle has been seen long enough to be in the map, and
+        the map holds it: an occupied cell within its radius of its centre."""
         seen = stamp - self.first_seen.get(a.obstacle.id, stamp)
-        return self.costmap is not None and seen >= self.p.map_confirm + 0.5
+        if self.costmap is None or seen < self.p.map_confirm + 0.5:
+            return False
+        ob = a.obstacle
+        reach = ob.radius + self.p.map_resolution
+        ring = np.array([[ob.position[0] + dx, ob.position[1] + dy]
+                         for dx in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
+                         for dy in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
+                         if dx * dx + dy * dy <= reach * reach])
+        return bool(self.costmap.lethal_at(ring).any())
 
     def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
         """Beyond the paper: whether the straight way to ``target`` is free on the map's
