@@ -135,7 +135,8 @@ class MotionCue:
     def score(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray) -> FloatArray:
         """Scores for this scan's clusters (max over the baselines), then remember it."""
         each, _ = self.score_each(scan, range_min, cluster_beams)
-        return each.max(axis=1, initial=0.0)
+        best: FloatArray = each.max(axis=1, initial=0.0)
+        return best
 
     def score_each(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray
                    ) -> tuple[FloatArray, FloatArray]:

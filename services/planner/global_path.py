@@ -93,13 +93,14 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
     costmap.grow_to(np.vstack([start, goal]), costmap.padding / 2)
     free = ~costmap.blocked()
     ny = free.shape[1]
-    s_cell = tuple(int(v) for v in costmap.cell_of(start[None, :])[0])
-    g_cell = tuple(int(v) for v in costmap.cell_of(goal[None, :])[0])
+    si, sj = (int(v) for v in costmap.cell_of(start[None, :])[0])
+    gi, gj = (int(v) for v in costmap.cell_of(goal[None, :])[0])
+    s_cell, g_cell = (si, sj), (gi, gj)
     if costmap.lethal_at(goal[None, :])[0]:
         return GlobalPlan(np.empty((0, 2)), math.inf, "goal occupied")
     reach = max(1, math.ceil(costmap.inflation / costmap.resolution) + 1)
-    g_free = g_cell if free[g_cell] else _nearest_free(free, (g_cell[0], g_cell[1]), reach)
-    s_free = s_cell if free[s_cell] else _nearest_free(free, (s_cell[0], s_cell[1]), 2 * reach)
+    g_free = g_cell if free[g_cell] else _nearest_free(free, g_cell, reach)
+    s_free = s_cell if free[s_cell] else _nearest_free(free, s_cell, 2 * reach)
     if g_free is None or s_free is None:
         return GlobalPlan(np.empty((0, 2)), math.inf, "no free cell at start or goal")
     if free.all() or (visible(free, costmap, start, goal) and s_free == s_cell
