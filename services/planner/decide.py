@@ -152,6 +152,13 @@ class Planner:
         s0, off_path = project(self.path, robot)
         default = self.goal if s0 + p.lookahead >= length else point_at(self.path,
                                                                           s0 + p.lookahead)
+        if len(self.path) > 2 and not self._chord_clear(robot, default):
+            # The path bends within the look-ahead and the chord would cut the corner
+            # into what the map holds: steer for the bend itself first.
+            lengths = arc_lengths(self.path)
+            k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
+            if k < len(self.path):
+                default = self.path[k]
         if not statics or off_path < p.cell / 2:
             return default
         rejoin = self._rejoin_point(robot, statics)
@@ -267,6 +274,19 @@ class Planner:
                 break
             end = d
         return end
+
+    def _chord_clear(self, robot: Vec, point: Vec) -> bool:
+        """Whether the straight way to ``point`` is free on the map (True without one)."""
+        if self.costmap is None:
+            return True
+        offset = point - robot
+        distance = float(np.hypot(*offset))
+        if distance <= self.p.map_resolution:
+            return True
+        direction = offset / distance
+        samples = path_points(robot + direction * self.p.map_resolution, direction,
+                              distance - self.p.map_resolution, self.p.map_resolution / 2)
+        return not bool(self.costmap.blocked_at(samples).any())
 
     def _mapped(self, a: Assessment, stamp: float) -> bool:
         """Whether a standing obstacle has been seen long enough to be in the map, and
@@ -531,8 +551,9 @@ class Planner:
         notes = self._assess_all(robot, target, in_window, slack, to_goal=self.detour is None)
         # A "new" obstacle has been seen once: it is answered from the next scan on, when
         # its type is known (the motor bridge's stop zone covers the meantime).
-        # On a detour the paper's boxes decide, as in the paper; on the path the map may.
-        clear = self.detour is None and self._map_clear(robot, target, to_goal=True)
+        # The map may clear the way to the target (the path's look-ahead point, or the
+        # detour's sub-target); whether a detour may end is still the boxes' call.
+        clear = self._map_clear(robot, target, to_goal=self.detour is None)
         threats = [self._sticky(a) for a in notes
                    if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
                    and not (a.letter == "b" and clear and self._mapped(a, stamp))]
@@ -727,7 +748,7 @@ class Planner:
             goal = (float(self.goal[0]), float(self.goal[1]))
             self.costmap = Costmap(
                 start, goal, resolution=p.map_resolution, decay=p.map_decay,
-                inflation=p.robot_radius + p.safety_margin + p.map_resolution / 2,
+                inflation=p.robot_radius + p.safety_margin,
                 confirm=p.map_confirm, padding=p.map_padding, max_size=p.map_max_size)
         if scan is None:
             return
