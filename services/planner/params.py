@@ -178,8 +178,10 @@ class Params(MissionParams, StopZoneParams):
     map_max_size: float = Field(200.0, gt=0, description="largest grid side, m")
     map_period: float = Field(1.0, gt=0, description="s between two published maps")
     scan_wait: float = Field(
-        0.25, gt=0, description="wall s the planner waits for the scan of a track list's "
-        "stamp before deciding without a map update"
+        1.0, gt=0, description="wall s the planner waits for the scan of a track list's "
+        "stamp before deciding without a map update; in real time the next track list "
+        "(0.1 s later at 10 Hz) ends the wait sooner, so this bound matters in lockstep "
+        "runs, where it keeps a loaded machine from changing the result"
     )
 
     # --- the global path (global_path.py) ---------------------------------------------
