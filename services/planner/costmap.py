@@ -81,6 +81,7 @@ class Costmap:
         self.now = -math.inf
         self.version = 0  # bumped whenever the occupied set may have changed
         self._inflated: tuple[int, BoolGrid, BoolGrid] | None = None
+        self._gap: npt.NDArray[np.float64] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -210,17 +211,26 @@ class Costmap:
                 self._inflated[1], lethal):
             return self._inflated[1], self._inflated[2]
         if lethal.any():
-            gap = distance_transform_edt(~lethal) * self.resolution
+            gap = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * self.resolution
             blocked = np.asarray(gap <= self.inflation)
         else:
+            gap = np.full(lethal.shape, math.inf)
             blocked = np.zeros_like(lethal)
         self._inflated = (key, lethal, blocked)
+        self._gap = gap
         return lethal, blocked
 
     def blocked(self) -> BoolGrid:
         """Cells whose centre lies within the inflation distance of an occupied cell:
         the robot's centre must not enter them."""
         return self._refresh()[1]
+
+    def gap(self) -> npt.NDArray[np.float64]:
+        """(nx, ny) distance from each cell's centre to the nearest occupied one, m (inf
+        when none is known)."""
+        self._refresh()
+        assert self._gap is not None
+        return self._gap
 
     def blocked_at(self, points: Vec) -> npt.NDArray[np.bool_]:
         """Whether each point (n, 2) lies in a blocked cell (outside the grid: free)."""

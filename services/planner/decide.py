@@ -716,7 +716,8 @@ class Planner:
             decision = self.guard_stop_zone(decision, pose, scan)
             waiting = decision.action in ("stop", "slow") and decision.kind == "dynamic"
             if self.recovery.watch(stamp, self.to_go(robot), waiting, decision.refused):
-                step = self.recovery.start_next(stamp, pose)
+                way = self.plan is None or self.plan.found
+                step = self.recovery.start_next(stamp, pose, way_known=way)
                 if step is None:
                     decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
                 else:

@@ -42,9 +42,11 @@ class DistanceField:
         return float(self.distance[i, j]) + 0.0
 
 
-def grid_graph(free: npt.NDArray[np.bool_], resolution: float) -> csr_matrix:
+def grid_graph(free: npt.NDArray[np.bool_], resolution: float,
+               cost: npt.NDArray[np.float64] | None = None) -> csr_matrix:
     """The 8-connected graph of the free cells of a (nx, ny) grid, edge weights in m
-    (1 or sqrt 2 cells); node ``i * ny + j`` is cell (i, j)."""
+    (1 or sqrt 2 cells, times 1 + the mean ``cost`` of the two cells when given);
+    node ``i * ny + j`` is cell (i, j)."""
     nx, ny = free.shape
     index = np.arange(nx * ny).reshape(nx, ny)
     rows, cols, weights = [], [], []
@@ -56,20 +58,25 @@ def grid_graph(free: npt.NDArray[np.bool_], resolution: float) -> csr_matrix:
         ok = fa & fb
         rows.append(a[ok])
         cols.append(b[ok])
-        weights.append(np.full(int(ok.sum()), w * resolution))
+        if cost is None:
+            weights.append(np.full(int(ok.sum()), w * resolution))
+        else:
+            flat = cost.ravel()
+            weights.append(w * resolution * (1.0 + (flat[a[ok]] + flat[b[ok]]) / 2.0))
     r = np.concatenate(rows)
     c = np.concatenate(cols)
     return coo_matrix((np.concatenate(weights), (r, c)), shape=(nx * ny, nx * ny)).tocsr()
 
 
 def grid_distances(
-    free: npt.NDArray[np.bool_], source: tuple[int, int], resolution: float
+    free: npt.NDArray[np.bool_], source: tuple[int, int], resolution: float,
+    cost: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
     """Shortest-way distance (m) from cell ``source`` to every cell of the grid over its
     free cells (inf where cut off), and each cell's predecessor toward the source
     (-9999 where none), both (nx, ny)."""
     nx, ny = free.shape
-    graph = grid_graph(free, resolution)
+    graph = grid_graph(free, resolution, cost)
     dist, pred = dijkstra(graph, directed=False, indices=source[0] * ny + source[1],
                           return_predecessors=True)
     return (np.asarray(dist, dtype=np.float64).reshape(nx, ny),

@@ -11,6 +11,7 @@ the straight line from the robot to the goal, exactly the paper's global path.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -62,25 +63,59 @@ def visible(free: BoolGrid, costmap: Costmap, a: Vec, b: Vec) -> bool:
     return bool(free[cells[ok, 0], cells[ok, 1]].all())
 
 
-def shortcut(free: BoolGrid, costmap: Costmap, points: Vec) -> Vec:
+def _cost_along(cost: npt.NDArray[np.float64], costmap: Costmap, points: Vec) -> float:
+    """The highest comfort cost over a polyline's cells (sampled every quarter cell)."""
+    worst = 0.0
+    for a, b in itertools.pairwise(points):
+        count = max(2, math.ceil(float(np.hypot(*(b - a))) / (costmap.resolution / 4)) + 1)
+        t = np.linspace(0.0, 1.0, count)[:, None]
+        cells = costmap.cell_of(a[None, :] + t * (b - a)[None, :])
+        ok = costmap.inside(cells)
+        if ok.any():
+            worst = max(worst, float(cost[cells[ok, 0], cells[ok, 1]].max()))
+    return worst
+
+
+def shortcut(free: BoolGrid, costmap: Costmap, points: Vec,
+             cost: npt.NDArray[np.float64] | None = None) -> Vec:
     """Line-of-sight shortcutting: from each kept vertex, the farthest later vertex it
-    sees in a straight line is the next one kept."""
+    sees in a straight line is the next one kept. With ``cost`` (the comfort cost of
+    each cell), a shortcut may not come nearer the obstacles than the grid path it
+    replaces did: it cuts corners of the way, not into the room kept round obstacles."""
     if len(points) <= 2:
         return points
+
+    def ok(i: int, j: int) -> bool:
+        if not visible(free, costmap, points[i], points[j]):
+            return False
+        if cost is None:
+            return True
+        return (_cost_along(cost, costmap, points[[i, j]])
+                <= _cost_along(cost, costmap, points[i:j + 1]) + 1e-9)
+
     kept = [0]
     i = 0
     last = len(points) - 1
     while i < last:
         j = last
-        while j > i + 1 and not visible(free, costmap, points[i], points[j]):
+        while j > i + 1 and not ok(i, j):
             # Binary-search-like back-off keeps long open stretches cheap.
             j = i + 1 + (j - i - 1) // 2 if j - i > 8 else j - 1
-        # Then move forward as far as still visible (the back-off may have overshot).
-        while j < last and visible(free, costmap, points[i], points[j + 1]):
+        # Then move forward as far as still allowed (the back-off may have overshot).
+        while j < last and ok(i, j + 1):
             j += 1
         kept.append(j)
         i = j
     return points[kept]
+
+
+COMFORT = 0.5
+"""m beyond the inflation over which a cell costs more the nearer it is to an obstacle
+(like the decaying cost of Nav2's inflation layer): the path keeps to the middle of a
+passage where it can, instead of grazing the inflation's edge."""
+COMFORT_WEIGHT = 2.0
+"""Extra cost per metre in a cell right at the inflation's edge (falling to 0 at
+``COMFORT`` beyond it)."""
 
 
 def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> GlobalPlan:
@@ -107,7 +142,9 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
                       and g_free == g_cell):
         length = float(np.hypot(*(goal - start)))
         return GlobalPlan(np.vstack([start, goal]), length, reason)
-    dist, pred = grid_distances(free, g_free, costmap.resolution)
+    room = costmap.gap() - costmap.inflation
+    cost = COMFORT_WEIGHT * np.clip((COMFORT - room) / COMFORT, 0.0, 1.0)
+    dist, pred = grid_distances(free, g_free, costmap.resolution, cost)
     if not math.isfinite(dist[s_free]):
         return GlobalPlan(np.empty((0, 2)), math.inf, "no way to the goal")
     cells = [s_free]
@@ -120,7 +157,7 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
         cells.append((node // ny, node % ny))
     centres = costmap.centre_of(np.array(cells, dtype=np.int64))
     points = np.vstack([start, centres[1:-1] if len(centres) > 2 else np.empty((0, 2)), goal])
-    points = shortcut(free, costmap, points)
+    points = shortcut(free, costmap, points, cost)
     length = float(np.hypot(*np.diff(points, axis=0).T).sum())
     return GlobalPlan(points, length, reason)
 

@@ -215,8 +215,8 @@ class Params(MissionParams, StopZoneParams):
     backup_speed: float = Field(0.05, gt=0, description="recovery back-up speed, m/s")
     wait_time: float = Field(5.0, ge=0, description="recovery wait: stand still, s")
     recovery_rounds: int = Field(
-        2, ge=1, description="rounds of the four recovery steps without progress before the "
-        "goal is declared unreachable"
+        2, ge=1, description="rounds of the four recovery steps without progress, with no "
+        "way to the goal on the map, before the goal is declared unreachable"
     )
 
     def effective_progress_timeout(self) -> float:

@@ -12,9 +12,10 @@ steps are tried one per failure, in this order:
 3. ``back_up``: reverse a short distance (only where the robot has just been);
 4. ``wait``: stand still a while, for movers to pass;
 
-then navigation is tried again. Progress resets the sequence. After ``max_rounds``
-rounds without progress, or whenever the goal has no way on the map once every step has
-been tried, the goal is ``unreachable``: the robot stops for good.
+then navigation is tried again. Progress resets the sequence. When the goal has no way
+on the map once every step has been tried (or after ``max_rounds`` rounds, if the map
+shows none), the goal is ``unreachable``: the robot stops for good. While a way is
+known, the rounds go on.
 """
 
 from __future__ import annotations
@@ -91,15 +92,21 @@ class Recovery:
                 and stamp - self.refused_since >= self.s.stop_zone_timeout)
         return zone or stamp - self.check_stamp >= self.s.progress_timeout
 
-    def start_next(self, stamp: float, pose: tuple[float, float, float]) -> Step | None:
-        """Begin the next step; None (and ``unreachable``) once every round is spent."""
+    def start_next(self, stamp: float, pose: tuple[float, float, float],
+                   way_known: bool = False) -> Step | None:
+        """Begin the next step; None (and ``unreachable``) once every round is spent with
+        no way to the goal known. While the map still shows a way (``way_known``) the
+        rounds start again: a goal is declared unreachable only for want of a way."""
         if self.level >= len(STEPS):
             self.level = 0
             self.rounds += 1
         if self.rounds >= self.s.max_rounds:
-            self.unreachable = True
-            self.active = None
-            return None
+            if way_known:
+                self.rounds = 0
+            else:
+                self.unreachable = True
+                self.active = None
+                return None
         step = STEPS[self.level]
         self.level += 1
         self.active = Active(step, stamp, pose, last_heading=pose[2])

@@ -45,11 +45,11 @@ def test_the_stop_zone_refusing_motion_asks_for_recovery_sooner() -> None:
     assert stalled is not None and 5.0 <= stalled <= 5.2
 
 
-def test_steps_come_in_order_and_the_goal_is_unreachable_after_the_rounds() -> None:
+def test_with_no_way_known_the_goal_is_unreachable_after_the_rounds() -> None:
     r = Recovery(SETTINGS)
     steps = []
     for k in range(9):
-        step = r.start_next(float(k), (0.0, 0.0, 0.0))
+        step = r.start_next(float(k), (0.0, 0.0, 0.0), way_known=False)
         steps.append(step)
         if step is not None:
             r.finish(float(k), 5.0)
@@ -64,3 +64,13 @@ def test_progress_starts_the_sequence_afresh() -> None:
     r.finish(11.0, 5.0)
     assert feed(r, 11.0, 20.0, lambda t: 5.0 - (t - 11.0)) is None  # moving on again
     assert r.start_next(20.0, (0.0, 0.0, 0.0)) == "replan"
+
+
+def test_while_a_way_is_known_the_rounds_go_on() -> None:
+    r = Recovery(SETTINGS)
+    steps = []
+    for k in range(12):
+        steps.append(r.start_next(float(k), (0.0, 0.0, 0.0), way_known=True))
+        r.finish(float(k), 5.0)
+    assert steps == ["replan", "spin", "back_up", "wait"] * 3
+    assert not r.unreachable

@@ -201,16 +201,23 @@ def test_with_nothing_driven_behind_there_is_no_back_up_then_a_wait_stands_still
     assert t - start == pytest.approx(3.0, abs=0.15)
 
 
-def test_a_walled_in_goal_ends_in_unreachable_and_the_robot_stops() -> None:
+def test_a_goal_inside_an_obstacle_ends_in_unreachable_and_the_robot_stops() -> None:
     p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
-    ring = [(6.5, 1.5, 9.5, 1.7), (6.5, 4.3, 9.5, 4.5), (6.5, 1.5, 6.7, 4.5)]
+    wall = [(8.02, 1.0, 8.5, 5.0)]  # its face runs through the goal's cell: no way there
     t = 0.0
     d = None
     while t < 120.0:
-        d = p.step(POSE, [], t, scan_of(POSE, boxes=ring))
+        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
         if d.action == "unreachable":
             break
         t = round(t + 0.1, 6)
     assert d is not None and d.action == "unreachable", d
+    assert p.plan is not None and p.plan.reason == "goal occupied"
     assert d.v == 0.0 and d.omega == 0.0
     assert p.step(POSE, [], t + 1.0).action == "unreachable"  # for good
+
+
+def test_while_a_way_is_known_recovery_goes_on_and_never_gives_up() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    actions = {p.step(POSE, [], round(k * 0.1, 6)).action for k in range(600)}
+    assert {"replan", "spin", "wait"} <= actions and "unreachable" not in actions
