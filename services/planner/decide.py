@@ -12,9 +12,14 @@ The responses follow Section 3.5 of the paper:
   around every obstacle in view when any threat needs one.
 
 Between decisions the robot heads for its target: a detour's sub-target, or else a
-point ``lookahead`` metres along the global path (the straight line from start to
-goal) beyond the robot's projection on it, which brings it back to the path after a
-detour.
+point ``lookahead`` metres along the global path beyond the robot's projection on it,
+which brings it back to the path after a detour.
+
+Beyond the paper, ``Planner.step`` runs these named stages (docs/navigation.md):
+``update_map`` (costmap.py) -> ``update_path`` (global_path.py: the straight start-goal
+line until the map says otherwise) -> ``recover`` (recovery.py) or ``local_layer`` (the
+paper's assess, respond, detour, speed and safety) -> ``guard_stop_zone`` (the motor
+bridge's zone) -> the command.
 """
 
 from __future__ import annotations
