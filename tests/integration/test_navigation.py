@@ -54,16 +54,7 @@ def test_there_is_a_scenario_for_every_class():
         assert any(needed in name for name in names), needed
 
 
-KNOWN_FAILING = {
-    "nav-posts-fast": "posts 1.2 m apart at 1 m/s: the paper's (b) test reads 0.5 m cell "
-                      "boxes that close the gaps, and Morphin's detours among them at top "
-                      "speed do not get through; recovery keeps it from harm, not stuck",
-}
-
-
-@pytest.mark.parametrize("path", [
-    pytest.param(p, marks=pytest.mark.xfail(reason=KNOWN_FAILING[p.stem], strict=True))
-    if p.stem in KNOWN_FAILING else p for p in SCENARIOS], ids=[p.stem for p in SCENARIOS])
+@pytest.mark.parametrize("path", SCENARIOS, ids=[p.stem for p in SCENARIOS])
 def test_class_scenario_is_reached_without_contact(path, records):
     record = records[path.stem]
     scenario = load_scenario(path)
