@@ -720,7 +720,8 @@ class Planner:
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(decision, pose, scan)
             waiting = decision.action in ("stop", "slow") and decision.kind == "dynamic"
-            if self.recovery.watch(stamp, self.to_go(robot), waiting, decision.refused):
+            if p.recovery and self.recovery.watch(stamp, self.to_go(robot), waiting,
+                                                  decision.refused):
                 way = self.plan is None or self.plan.found
                 step = self.recovery.start_next(stamp, pose, way_known=way)
                 if step is None:

@@ -195,6 +195,10 @@ class Params(MissionParams, StopZoneParams):
     )
 
     # --- recovery (recovery.py) -------------------------------------------------------
+    recovery: bool = Field(
+        True, description="beyond the paper: watch progress and recover (replan, spin, back "
+        "up, wait; unreachable) when it stalls (paper: False)"
+    )
     progress_distance: float = Field(
         0.5, gt=0, description="distance to go that must be gained within "
         "progress_timeout, m (Nav2's progress checker: 0.5 m)"
