@@ -12,10 +12,12 @@ from dataclasses import dataclass
 
 from zenav.schemas.messages import (
     BaseCommand,
+    GlobalPath,
     GroundTruth,
     LaserScan,
     Message,
     ObstacleChain,
+    OccupancyMap,
     Odometry,
     PlannerEvent,
     PlannerState,
@@ -52,6 +54,8 @@ CMD_VEL = Topic("cmd_vel", VelocityCommand, max_bytes=1024)
 EVENTS = Topic("planner/events", PlannerEvent)
 EVENT_HISTORY = Topic("planner/history", PlannerEvent)  # queryable: every event so far
 PLANNER_STATE = Topic("planner/state", PlannerState)
+PATH = Topic("planner/path", GlobalPath, max_bytes=256 * 1024)
+MAP = Topic("planner/map", OccupancyMap, max_bytes=8 * 1024 * 1024)  # 2000 x 2000 cells
 TRUTH = Topic("sim/truth", GroundTruth, max_bytes=256 * 1024)
 RESULT = Topic("sim/result", RunResult, max_bytes=16 * 1024 * 1024)
 STATUS = Topic("status", ServiceStatus)  # zenav/<robot>/status/<service>
@@ -66,6 +70,8 @@ TOPICS: tuple[Topic, ...] = (
     CMD_VEL,
     EVENTS,
     PLANNER_STATE,
+    PATH,
+    MAP,
     TRUTH,
     RESULT,
 )

@@ -32,7 +32,8 @@ from pydantic import (
 
 ObstacleKind = Literal["new", "static", "dynamic"]
 ScenarioLetter = Literal["a", "b", "c", "d", "e", "f", "g", "h"]
-Action = Literal["keep", "slow", "stop", "speed_up", "morphin", "resume", "goal", "safety_stop"]
+Action = Literal["keep", "slow", "stop", "speed_up", "morphin", "resume", "goal", "safety_stop",
+                 "replan", "spin", "back_up", "wait", "unreachable"]
 
 
 def _array_validator(dtype: str, ndim: int, width: int = 5) -> Any:
@@ -98,6 +99,24 @@ Rows3Array = Annotated[
                     "description": "little-endian float64 rows [t, x, y], packed"}),
 ]
 """An (n, 3) float64 array, carried as raw bytes on the wire."""
+
+Rows2Array = Annotated[
+    npt.NDArray[np.float64],
+    BeforeValidator(_array_validator("<f8", 2, width=2)),
+    PlainSerializer(_array_bytes("<f8"), return_type=bytes),
+    WithJsonSchema({"type": "string", "contentEncoding": "binary",
+                    "description": "little-endian float64 rows [x, y], packed"}),
+]
+"""An (n, 2) float64 array of points, carried as raw bytes on the wire."""
+
+Int8Array = Annotated[
+    npt.NDArray[np.int8],
+    BeforeValidator(_array_validator("i1", 1)),
+    PlainSerializer(_array_bytes("i1"), return_type=bytes),
+    WithJsonSchema({"type": "string", "contentEncoding": "binary",
+                    "description": "int8 values, packed"}),
+]
+"""A 1-D int8 array, carried as raw bytes on the wire."""
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
@@ -228,6 +247,10 @@ class Obstacle(BaseModel):
     moved: float = Field(
         0.0, ge=0.0, le=1.0, description="free-space motion score (0 = stood still)"
     )
+    moved_each: list[tuple[NonNegative, float]] = Field(
+        default_factory=list, max_length=8,
+        description="the motion score against each earlier scan compared with: (its stamp, "
+        "score); a tracker ignores those taken before the obstacle was first seen")
 
 
 class ObstacleChain(Message):
@@ -292,6 +315,45 @@ class PlannerState(Message):
     action: Action
     target: tuple[Finite, Finite] = Field(description="current (sub-)target, m")
     speed: NonNegative = Field(description="commanded cruise speed, m/s")
+
+
+class GlobalPath(Message):
+    """The planner's global path, published whenever it is planned again."""
+
+    TYPE = "global_path"
+    points: Rows2Array = Field(description="vertices [x, y] from the robot to the goal, m; "
+                               "none when no way is known")
+    reason: str = Field("", max_length=100, description="why it was planned")
+
+    @field_validator("points")
+    @classmethod
+    def _finite(cls, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        if not np.isfinite(points).all():
+            raise ValueError("non-finite path point")
+        return points
+
+
+class OccupancyMap(Message):
+    """The planner's occupancy grid, at a low rate: cell (ix, iy) spans
+    [origin + (ix, iy) * resolution, origin + (ix + 1, iy + 1) * resolution)."""
+
+    TYPE = "occupancy_map"
+    origin: tuple[Finite, Finite] = Field(description="lower-left corner of cell (0, 0), m")
+    resolution: Positive = Field(description="cell side, m")
+    width: int = Field(ge=1, description="cells along x")
+    height: int = Field(ge=1, description="cells along y")
+    cells: Int8Array = Field(description="row by row (iy, then ix), as ROS OccupancyGrid: "
+                             "-1 unknown, 0 free, 100 occupied")
+
+    @model_validator(mode="after")
+    def _check(self) -> OccupancyMap:
+        if self.cells.size != self.width * self.height:
+            raise ValueError(f"{self.cells.size} cells for a {self.width} x {self.height} grid")
+        return self
+
+    def grid(self) -> npt.NDArray[np.int8]:
+        """The cells as (width, height), indexed [ix, iy]."""
+        return self.cells.reshape(self.height, self.width).T
 
 
 class VelocityCommand(Message):
@@ -382,6 +444,8 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     TrackList,
     PlannerEvent,
     PlannerState,
+    GlobalPath,
+    OccupancyMap,
     VelocityCommand,
     BaseCommand,
     GroundTruth,

@@ -119,7 +119,9 @@ def stack_params(
                     "cell": cell, "window_radius": window},
         "motor_bridge": {"max_speed": robot.effective_max_speed, "robot_radius": robot.radius,
                          "command_period": scan_period,
-                         "stale_timeout": max(0.5, 3 * scan_period)},
+                         "stale_timeout": max(0.5, 3 * scan_period),
+                         # The paper planner reverses only in its bounded recovery back-up.
+                         **({"allow_reverse": True} if planner == "paper" else {})},
     }
 
 

@@ -54,6 +54,8 @@ PROFILES: dict[str, dict[str, dict[str, Any]]] = {
             "around_obstacles": False,
             "extend_past": False,
             "escape_fan_deg": 85.0,  # = fan_max_deg: no wider escape fan
+            "use_map": False,  # no map: the global path is the straight start-goal line
+            "recovery": False,  # no progress checker, no recovery steps
         },
     },
 }

@@ -30,7 +30,7 @@ from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
 from zenav.services.planner.decide import Decision, Detour, Planner
-from zenav.services.planner.node import EventLog, EventRow, obstacles_of
+from zenav.services.planner.node import EventLog, EventRow, obstacles_of, scan_data
 from zenav.services.planner.params import Params as PlannerParams
 from zenav.services.planner.prediction import Assessment, Obstacle
 from zenav.services.tracking.node import track_message
@@ -135,7 +135,7 @@ class Pipeline:
                                                              heading=pose[2]), tracks=tracks)
         obstacles = obstacles_of(track_list)
         with self.clock.stage("planner"):
-            decision = self.planner.step(pose, obstacles, t)
+            decision = self.planner.step(pose, obstacles, t, scan_data(scan, pose))
         return Step(t, scan, clusters, tracks, track_list, obstacles, decision)
 
 

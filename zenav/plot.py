@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle, Rectangle
 
+from zenav.schemas.messages import OccupancyMap
 from zenav.sim.scenario import ObstacleSpec, Scenario
 
 OUTCOME_COLOURS = {"reached": "tab:green", "collision": "tab:red", "timeout": "tab:orange"}
@@ -80,12 +81,25 @@ def _nearest_rows(record: dict[str, Any], t: float) -> int:
 # --- run.png ------------------------------------------------------------------------------
 
 
-def plot_run(scenario: Scenario, record: dict[str, Any], path: Path) -> None:
-    """Write ``path`` (PNG) for a run record as written to run.json."""
+def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
+             occupancy: OccupancyMap | None = None) -> None:
+    """Write ``path`` (PNG) for a run record as written to run.json; with the planner's
+    last map when given (occupied cells dark, free ones light), and its last global path
+    when the record has one (``path``)."""
     width, height = scenario.world.size
     with PLOT_LOCK:
         fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
         _world(ax, scenario, "0.92", max_cells=60)
+        if occupancy is not None:
+            grid = occupancy.grid().astype(float)
+            shade = np.where(grid < 0, np.nan, np.where(grid > 50, 0.55, 0.97))
+            x0, y0 = occupancy.origin
+            r = occupancy.resolution
+            ax.imshow(shade.T, origin="lower", cmap="gray", vmin=0.0, vmax=1.0, alpha=0.6,
+                      extent=(x0, x0 + r * occupancy.width, y0, y0 + r * occupancy.height),
+                      interpolation="nearest", zorder=0)
+            ax.set_xlim(0, width)
+            ax.set_ylim(0, height)
         end = float(record["time"])
         agent_paths = record.get("agents", {})  # ORCA agents: their paths come from the run
         for index, ob in enumerate(scenario.obstacles):
@@ -104,7 +118,11 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path) -> None:
             ax.annotate(str(index), (cx, cy), ha="center", va="center", fontsize=7,
                         color="white")
         start, goal = scenario.robot.start, scenario.robot.goal
-        _global_path(ax, scenario, label="global path")
+        if record.get("path"):
+            px, py = zip(*record["path"], strict=True)
+            ax.plot(px, py, ls="--", color="tab:green", lw=1, label="global path (last)")
+        else:
+            _global_path(ax, scenario, label="global path")
         traj = record["trajectory"]
         xs = [row[1] for row in traj]
         ys = [row[2] for row in traj]
@@ -183,7 +201,11 @@ def draw_experiment(scenario: Scenario, record: dict[str, Any], path: Path,
             label = f"{'D' if moving else 'S'}{index}"
             ax.annotate(label, (cx, cy), xytext=(3, 3), textcoords="offset points", fontsize=7)
         start, goal = scenario.robot.start, scenario.robot.goal
-        _global_path(ax, scenario, label="global path")
+        if record.get("path"):
+            px, py = zip(*record["path"], strict=True)
+            ax.plot(px, py, ls="--", color="tab:green", lw=1, label="global path (last)")
+        else:
+            _global_path(ax, scenario, label="global path")
         ax.plot(traj[:, 1], traj[:, 2], color="tab:blue", lw=1.6, label="trajectory")
         points = decision_points(record)
         windows: list[tuple[float, float]] = []

@@ -13,6 +13,7 @@ import contextlib
 import json
 import math
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +21,7 @@ from zenav.launch import Stack
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
-from zenav.schemas.messages import Odometry, PlannerEvent, RunResult
+from zenav.schemas.messages import GlobalPath, OccupancyMap, Odometry, PlannerEvent, RunResult
 from zenav.services.config import (
     SERVICE_ORDER,
     ConfigError,
@@ -109,11 +110,21 @@ def make_record(result: RunResult, events: list[PlannerEvent], planner: str) -> 
     return record
 
 
-async def _collect(stack: Stack, progress_timeout: float,
-                   record: Path | None = None) -> tuple[RunResult, list[PlannerEvent]]:
-    """Join the stack, gather events until the simulator's result arrives; with
-    ``record``, write every message of the run there as MCAP (zenav's msgpack channels and
-    the Foxglove ones)."""
+@dataclass
+class Heard:
+    """The newest global path and map the planner published (the paper planner does;
+    the baselines publish neither)."""
+
+    path: GlobalPath | None = None
+    occupancy: OccupancyMap | None = None
+
+
+async def _collect(stack: Stack, progress_timeout: float, record: Path | None = None,
+                   heard: Heard | None = None) -> tuple[RunResult, list[PlannerEvent]]:
+    """Join the stack, gather events until the simulator's result arrives (and the
+    newest path and map into ``heard``); with ``record``, write every message of the run
+    there as MCAP (zenav's msgpack channels and the Foxglove ones)."""
+    heard = heard if heard is not None else Heard()
     k = Keys(stack.robot_id)
     bus = ZenohBus(stack.transport(driver=True), asyncio.get_running_loop())
     recording = _Recording(bus, record, stack.robot_id) if record is not None else None
@@ -153,6 +164,8 @@ async def _collect(stack: Stack, progress_timeout: float,
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
         odom = bus.subscribe(k.of(keys.ODOM), depth=1)
+        paths = bus.subscribe(k.of(keys.PATH), depth=1)
+        maps = bus.subscribe(k.of(keys.MAP), depth=1)
         events: list[PlannerEvent] = []
         last_progress = time.monotonic()
         sim_time = -1.0
@@ -166,6 +179,14 @@ async def _collect(stack: Stack, progress_timeout: float,
                 result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
             except (TimeoutError, DecodeError):
                 pass
+            while paths.pending():
+                with contextlib.suppress(DecodeError):
+                    heard.path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
+                                        keys.PATH.max_bytes)
+            while maps.pending():
+                with contextlib.suppress(DecodeError):
+                    heard.occupancy = decode((await maps.get())[1], OccupancyMap,
+                                             k.of(keys.MAP), keys.MAP.max_bytes)
             while odom.pending():
                 _, payload = await odom.get()
                 try:
@@ -257,8 +278,9 @@ def run_scenario(
     started = time.monotonic()
     stack.start()
     try:
+        heard = Heard()
         result, events = asyncio.run(_collect(stack, progress_timeout,
-                                              out_dir / "run.mcap" if mcap else None))
+                                              out_dir / "run.mcap" if mcap else None, heard))
     finally:
         codes = stack.stop()
     record = make_record(result, events, planner)
@@ -266,6 +288,9 @@ def run_scenario(
     record["seed"] = scenario.seed
     if profile != DEFAULT_PROFILE:
         record["profile"] = profile
+    if heard.path is not None:  # optional field: the last global path, [[x, y], ...]
+        record["path"] = [[round(float(x), 4), round(float(y), 4)]
+                          for x, y in heard.path.points]
     unclean = {name: code for name, code in codes.items() if code != 0}
     if unclean:
         record["unclean_exits"] = unclean
@@ -273,5 +298,5 @@ def run_scenario(
     if picture:
         from zenav.plot import plot_run  # matplotlib is slow to import; only here
 
-        plot_run(scenario, record, out_dir / "run.png")
+        plot_run(scenario, record, out_dir / "run.png", occupancy=heard.occupancy)
     return record

@@ -7,7 +7,6 @@ from typing import Literal
 from zenav.schemas.messages import LaserScan
 from zenav.services.geometry import limit_velocity
 from zenav.services.motor_bridge.params import Params
-from zenav.services.motor_bridge.stop_zone import stop_distance, zone_blocked
 
 
 class Limiter:
@@ -22,7 +21,7 @@ class Limiter:
     def apply(self, stamp: float, v: float, omega: float) -> tuple[float, float]:
         p = self.params
         dt = p.command_period if self.stamp is None else max(stamp - self.stamp, 0.0)
-        v_low = -p.max_speed if p.allow_reverse else 0.0
+        v_low = -min(p.max_reverse_speed, p.max_speed) if p.allow_reverse else 0.0
         v_target = min(max(v, v_low), p.max_speed)
         self.v = limit_velocity(self.v, v_target, p.accel, p.decel, dt, p.max_speed)
         self.omega = limit_velocity(
@@ -49,11 +48,10 @@ class CommandFilter:
 
     def blocked(self, scan: LaserScan | None, v: float) -> bool:
         p = self.params
-        if not p.stop_zone or scan is None:
+        if scan is None:
             return False
-        ahead = stop_distance(v, p.zone_reaction, p.decel, p.zone_margin)
-        return zone_blocked(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_max,
-                            v, p.robot_radius, p.zone_side_margin, ahead)
+        return p.blocks(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_max, v,
+                        p.robot_radius)
 
     def apply(
         self, stamp: float, v: float, omega: float, scan: LaserScan | None

@@ -5,20 +5,26 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
-from zenav.services.mission import ACCEL, DECEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS
+from zenav.services.mission import ACCEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS
+from zenav.services.motor_bridge.stop_zone import StopZoneParams
 from zenav.services.ros2.params import Ros2Params
 
 
-class Params(BaseModel):
+class Params(StopZoneParams):
+    """The bridge's limits; the stop zone's geometry (``stop_zone``, ``zone_*``, ``decel``)
+    is ``StopZoneParams``, which the planner includes too."""
+
     model_config = ConfigDict(extra="forbid")
 
     max_speed: float = Field(MAX_SPEED, gt=0, description="forward speed limit, m/s")
     allow_reverse: bool = Field(False, description="whether negative speeds pass")
+    max_reverse_speed: float = Field(
+        0.1, gt=0, description="reverse speed limit when allow_reverse, m/s (the paper "
+        "planner backs up only in recovery, slowly: the laser does not see behind)")
     max_omega: float = Field(MAX_OMEGA, gt=0, description="turn rate limit, rad/s")
     accel: float = Field(ACCEL, gt=0, description="forward acceleration limit, m/s^2")
-    decel: float = Field(DECEL, gt=0, description="forward deceleration limit, m/s^2")
     angular_accel: float = Field(4.0, gt=0, description="turn rate change limit, rad/s^2")
     stale_timeout: float = Field(
         0.5, gt=0, description="s without a command before the robot is stopped"
@@ -30,15 +36,7 @@ class Params(BaseModel):
         "sim", description="'realtime' adds a wall-clock watchdog to the stamp-clock check"
     )
     watchdog_period: float = Field(0.05, gt=0, description="wall s between watchdog checks")
-    stop_zone: bool = Field(True, description="refuse forward motion toward a return in the "
-                            "zone ahead (reads the raw scan)")
     robot_radius: float = Field(ROBOT_RADIUS, gt=0, description="disc footprint, m")
-    zone_side_margin: float = Field(0.02, ge=0, description="zone half-width beyond the "
-                                    "robot radius, m")
-    zone_margin: float = Field(0.08, ge=0, description="zone length beyond the robot's "
-                               "front at standstill, m")
-    zone_reaction: float = Field(0.3, ge=0, description="s of travel added to the zone: one "
-                                 "command period and some")
     backend: Literal["native", "ros2"] = Field(
         "native", description="native: BaseCommand on device/base_cmd only; ros2: also "
         "Twist (or TwistStamped) to a ROS 2 robot over rmw_zenoh")

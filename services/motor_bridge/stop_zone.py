@@ -12,6 +12,35 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
+from pydantic import BaseModel, Field
+
+from zenav.services.mission import DECEL
+
+
+class StopZoneParams(BaseModel):
+    """The stop zone's geometry: the one definition both the motor bridge (which enforces
+    it) and the planner (which never asks for motion into it) include in their
+    parameters, so the two can never disagree by a default."""
+
+    stop_zone: bool = Field(True, description="refuse forward motion toward a return in the "
+                            "zone ahead (reads the raw scan)")
+    zone_side_margin: float = Field(0.02, ge=0, description="zone half-width beyond the "
+                                    "robot radius, m")
+    zone_margin: float = Field(0.08, ge=0, description="zone length beyond the robot's "
+                               "front at standstill, m")
+    zone_reaction: float = Field(0.3, ge=0, description="s of travel added to the zone: one "
+                                 "command period and some")
+    decel: float = Field(DECEL, gt=0, description="forward deceleration limit of the base, "
+                         "m/s^2 (also sets how long the zone reaches)")
+
+    def blocks(self, ranges: npt.NDArray[np.float32], angle_min: float, angle_increment: float,
+               range_max: float, v: float, robot_radius: float) -> bool:
+        """Whether this zone, for a robot asked to go ``v`` m/s, holds a return."""
+        if not self.stop_zone:
+            return False
+        ahead = stop_distance(v, self.zone_reaction, self.decel, self.zone_margin)
+        return zone_blocked(ranges, angle_min, angle_increment, range_max, v, robot_radius,
+                            self.zone_side_margin, ahead)
 
 
 def stop_distance(v: float, reaction: float, decel: float, margin: float) -> float:

@@ -106,6 +106,10 @@ class Clusters:
     cell: float
     moved: FloatArray | None = None
     """(n,) free-space motion score in [0, 1] (``motion_cue.py``); None when not measured."""
+    moved_each: FloatArray | None = None
+    """(n, k) the same score against each of the k earlier scans compared with."""
+    moved_refs: FloatArray | None = None
+    """(k,) stamps of those earlier scans, s (nan: none yet)."""
 
     def __len__(self) -> int:
         return int(self.area.shape[0])

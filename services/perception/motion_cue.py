@@ -134,18 +134,31 @@ class MotionCue:
 
     def score(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray) -> FloatArray:
         """Scores for this scan's clusters (max over the baselines), then remember it."""
+        each, _ = self.score_each(scan, range_min, cluster_beams)
+        best: FloatArray = each.max(axis=1, initial=0.0)
+        return best
+
+    def score_each(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray
+                   ) -> tuple[FloatArray, FloatArray]:
+        """(n, k) scores of this scan's clusters against each baseline's earlier scan, and
+        (k,) the stamps of those scans (nan where none is remembered yet); then remember
+        this scan. A consumer that knows when an obstacle was first seen can ignore the
+        comparisons with scans taken before: an obstacle that appeared out of nothing
+        occupies space those scans saw empty without having moved."""
         window = self._window(scan, range_min)
-        scores = np.zeros(len(cluster_beams))
-        for baseline in self.baselines:
+        scores = np.zeros((len(cluster_beams), len(self.baselines)))
+        stamps = np.full(len(self.baselines), np.nan)
+        for j, baseline in enumerate(self.baselines):
             past = self._at_least(scan.stamp - baseline)
             if past is not None:
-                scores = np.maximum(scores, motion_scores(scan, cluster_beams, window, past[0],
-                                                          past[1], self.margin, self.reach))
+                stamps[j] = past[0].stamp
+                scores[:, j] = motion_scores(scan, cluster_beams, window, past[0], past[1],
+                                             self.margin, self.reach)
         self._scans.append((scan, window))
         oldest = scan.stamp - self.baselines[-1] - 1.0
         while len(self._scans) > 1 and self._scans[1][0].stamp <= oldest:
             self._scans.pop(0)
-        return scores
+        return scores, stamps
 
     def _at_least(self, stamp: float) -> tuple[ScanSnapshot, IntArray] | None:
         """The newest remembered scan taken at or before ``stamp``."""

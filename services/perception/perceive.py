@@ -25,5 +25,6 @@ class Perceiver:
                                 scan.range_min, scan.range_max, pose, self.params)
         snapshot = ScanSnapshot(scan.stamp, pose, scan.ranges.astype(np.float64),
                                 scan.angle_min, scan.angle_increment, scan.range_max)
-        moved = self.cue.score(snapshot, scan.range_min, clusters.beams)
-        return dataclasses.replace(clusters, moved=moved)
+        each, stamps = self.cue.score_each(snapshot, scan.range_min, clusters.beams)
+        return dataclasses.replace(clusters, moved=each.max(axis=1, initial=0.0),
+                                   moved_each=each, moved_refs=stamps)

@@ -38,6 +38,7 @@ def to_message(clusters: Clusters, stamp: float, seq: int, window_radius: float)
             radius=float(clusters.radius[k]),
             edges=(int(clusters.edge_start[k]), int(clusters.edge_end[k])),
             moved=float(clusters.moved[k]) if clusters.moved is not None else 0.0,
+            moved_each=_each(clusters, k),
         )
         for k in range(len(clusters))
     ]
@@ -51,6 +52,24 @@ def to_message(clusters: Clusters, stamp: float, seq: int, window_radius: float)
     )
 
 
+def _each(clusters: Clusters, k: int) -> list[tuple[float, float]]:
+    if clusters.moved_each is None or clusters.moved_refs is None:
+        return []
+    return [(float(stamp), float(min(max(score, 0.0), 1.0)))
+            for stamp, score in zip(clusters.moved_refs, clusters.moved_each[k], strict=True)
+            if np.isfinite(stamp)]
+
+
+def _each_arrays(obs: list[Obstacle]) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The per-baseline scores back as arrays; None unless every obstacle has the same
+    earlier scans (as perception sends them)."""
+    refs = [tuple(stamp for stamp, _ in o.moved_each) for o in obs]
+    if not refs[0] or any(r != refs[0] for r in refs):
+        return None, None
+    each = np.asarray([[score for _, score in o.moved_each] for o in obs], dtype=np.float64)
+    return each, np.asarray(refs[0], dtype=np.float64)
+
+
 def from_message(chain: ObstacleChain) -> Clusters:
     pose = (chain.pose.x, chain.pose.y, chain.pose.heading)
     obs = chain.obstacles
@@ -60,6 +79,7 @@ def from_message(chain: ObstacleChain) -> Clusters:
     def floats(rows: list[tuple[float, float]]) -> np.ndarray:
         return np.asarray(rows, dtype=np.float64).reshape(-1, 2)
 
+    each, refs = _each_arrays(obs)
     return Clusters(
         centre=floats([(o.x, o.y) for o in obs]),
         mean_rho=np.asarray([o.rho for o in obs], dtype=np.float64),
@@ -75,6 +95,8 @@ def from_message(chain: ObstacleChain) -> Clusters:
         edge_start=np.asarray([o.edges[0] for o in obs], dtype=np.int64),
         edge_end=np.asarray([o.edges[1] for o in obs], dtype=np.int64),
         moved=np.asarray([o.moved for o in obs], dtype=np.float64),
+        moved_each=each,
+        moved_refs=refs,
         pose=pose,
         cell=chain.cell,
     )

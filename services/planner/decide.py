@@ -12,9 +12,14 @@ The responses follow Section 3.5 of the paper:
   around every obstacle in view when any threat needs one.
 
 Between decisions the robot heads for its target: a detour's sub-target, or else a
-point ``lookahead`` metres along the global path (the straight line from start to
-goal) beyond the robot's projection on it, which brings it back to the path after a
-detour.
+point ``lookahead`` metres along the global path beyond the robot's projection on it,
+which brings it back to the path after a detour.
+
+Beyond the paper, ``Planner.step`` runs these named stages (docs/navigation.md):
+``update_map`` (costmap.py) -> ``update_path`` (global_path.py: the straight start-goal
+line until the map says otherwise) -> ``recover`` (recovery.py) or ``local_layer`` (the
+paper's assess, respond, detour, speed and safety) -> ``guard_stop_zone`` (the motor
+bridge's zone) -> the command.
 """
 
 from __future__ import annotations
@@ -28,8 +33,17 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
+from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import command_toward
+from zenav.services.planner.global_path import (
+    GlobalPlan,
+    arc_lengths,
+    first_blocked,
+    plan_path,
+    point_at,
+    project,
+)
 from zenav.services.planner.morphin import Mover, cells_on_segment, choose_detour
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import (
@@ -40,6 +54,7 @@ from zenav.services.planner.prediction import (
     gap_to_boxes,
     path_points,
 )
+from zenav.services.planner.recovery import STEPS, Recovery, RecoverySettings
 
 Vec = npt.NDArray[np.float64]
 
@@ -55,6 +70,7 @@ class Decision:
     kind: ObstacleKind | None
     speed: float  # the speed asked for before steering, m/s
     notes: tuple[Assessment, ...] = ()  # every obstacle that relates to the path
+    refused: bool = False  # forward motion withheld: the stop zone holds a return
 
 
 @dataclass
@@ -99,10 +115,33 @@ class Planner:
         self.first_seen: dict[int, float] = {}  # obstacle id -> stamp
         self.sides: dict[int, int] = {}  # obstacle id -> side it was last passed on
         self.asked = params.cruise_speed  # V_R of Algorithm 1, for slow_step
+        self.costmap: Costmap | None = None
+        self.plan: GlobalPlan | None = None
+        self.path: Vec | None = None  # the global path's vertices, robot to goal
+        self.plan_count = 0  # bumped at every new path
+        self.last_replan = -math.inf
+        self.replan_asked: str | None = None  # why the next cycle must re-plan
+        self.recovery = Recovery(RecoverySettings(
+            progress_distance=params.progress_distance,
+            progress_timeout=params.effective_progress_timeout(),
+            stop_zone_timeout=params.stop_zone_timeout, wait_allowance=params.wait_allowance,
+            spin_angle=params.spin_angle(), backup_distance=params.backup_distance,
+            backup_speed=params.backup_speed, wait_time=params.wait_time,
+            max_rounds=params.recovery_rounds))
+        self.trail: list[tuple[float, float]] = []  # where the robot has been, m
+        self.last_v = 0.0
         if self.start is not None:
-            self.global_cells = cells_on_segment(self.start, self.goal, params.cell)
+            self._set_path(np.vstack([self.start, self.goal]), "start")
 
     # -- geometry ----------------------------------------------------------------------
+
+    def _set_path(self, points: Vec, reason: str) -> None:
+        self.path = np.asarray(points, dtype=np.float64)
+        self.plan_count += 1
+        cells: set[tuple[int, int]] = set()
+        for a, b in zip(self.path[:-1], self.path[1:], strict=True):
+            cells |= cells_on_segment(a, b, self.p.cell)
+        self.global_cells = cells
 
     def path_target(self, robot: Vec, statics: list[Obstacle] | None = None) -> Vec:
         """Where to steer on the global path: ``lookahead`` m beyond the robot's
@@ -110,22 +149,25 @@ class Planner:
         the farthest point of the path within the window that it can drive to in a
         straight line clear of them (beyond the paper: it rejoins the path past the
         obstacles it went round instead of cutting back into them)."""
-        assert self.start is not None
+        assert self.path is not None
         p = self.p
-        axis = self.goal - self.start
-        length = float(np.hypot(*axis))
+        length = float(arc_lengths(self.path)[-1])
         if length < 1e-9:
             return self.goal
-        unit = axis / length
-        s0 = float((robot - self.start) @ unit)
-        default = self.goal if s0 + p.lookahead >= length else (
-            self.start + unit * max(s0 + p.lookahead, 0.0))
-        rel = robot - self.start
-        off_path = abs(float(unit[0] * rel[1] - unit[1] * rel[0]))
+        s0, off_path = project(self.path, robot)
+        default = self.goal if s0 + p.lookahead >= length else point_at(self.path,
+                                                                          s0 + p.lookahead)
+        if len(self.path) > 2 and not self._chord_clear(robot, default):
+            # The path bends within the look-ahead and the chord would cut the corner
+            # into what the map holds: steer for the bend itself first.
+            lengths = arc_lengths(self.path)
+            k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
+            if k < len(self.path):
+                default = self.path[k]
         if not statics or off_path < p.cell / 2:
             return default
         rejoin = self._rejoin_point(robot, statics)
-        if rejoin is None or float((rejoin - self.start) @ unit) < s0 + p.lookahead:
+        if rejoin is None or project(self.path, rejoin)[0] < s0 + p.lookahead:
             return default
         return rejoin
 
@@ -155,18 +197,16 @@ class Planner:
     def _rejoin_point(self, point: Vec, statics: list[Obstacle]) -> Vec | None:
         """The farthest point of the global path within the window that ``point`` sees
         in a straight line clear of ``statics``; None if there is none."""
-        assert self.start is not None
+        assert self.path is not None
         p = self.p
-        axis = self.goal - self.start
-        length = float(np.hypot(*axis))
+        length = float(arc_lengths(self.path)[-1])
         if length < 1e-9:
             return None
-        unit = axis / length
-        s0 = float((point - self.start) @ unit)
+        s0 = project(self.path, point)[0]
         lows, highs = self._boxes(statics)
         need = p.robot_radius + p.safety_margin
         for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
-            on_path = self.start + unit * max(float(s), 0.0)
+            on_path = point_at(self.path, max(float(s), 0.0))
             leg = on_path - point
             leg_length = float(np.hypot(*leg))
             if leg_length > p.window_radius:
@@ -203,7 +243,7 @@ class Planner:
         direction = offset / distance
         length = distance
         if to_goal:  # along the global path the robot goes on past the look-ahead point
-            length = max(distance, min(float(np.hypot(*(self.goal - robot))),
+            length = max(distance, min(self._straight_ahead(robot, direction),
                                        self.p.window_radius))
         p = self.p
         found = []
@@ -221,6 +261,73 @@ class Planner:
             if a is not None:
                 found.append(a)
         return found
+
+    def _straight_ahead(self, robot: Vec, direction: Vec) -> float:
+        """How far the global path runs on from the robot in ``direction`` before it
+        bends: the distance to the goal on the paper's straight path, to the next vertex
+        on one that goes round what the map holds."""
+        if self.path is None or len(self.path) <= 2:
+            return float(np.hypot(*(self.goal - robot)))
+        s0 = project(self.path, robot)[0]
+        lengths = arc_lengths(self.path)
+        k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
+        end = 0.0
+        for vertex in self.path[k:]:
+            leg = vertex - robot
+            d = float(np.hypot(*leg))
+            if d > 1e-9 and float(leg @ direction) / d < 0.999:
+                break
+            end = d
+        return end
+
+    def _chord_clear(self, robot: Vec, point: Vec) -> bool:
+        """Whether the straight way to ``point`` is free on the map (True without one)."""
+        if self.costmap is None:
+            return True
+        offset = point - robot
+        distance = float(np.hypot(*offset))
+        if distance <= self.p.map_resolution:
+            return True
+        direction = offset / distance
+        samples = path_points(robot + direction * self.p.map_resolution, direction,
+                              distance - self.p.map_resolution, self.p.map_resolution / 2)
+        return not bool(self.costmap.blocked_at(samples).any())
+
+    def _mapped(self, a: Assessment, stamp: float) -> bool:
+        """Whether a standing obstacle has been seen long enough to be in the map, and
+        the map holds it: an occupied cell within its radius of its centre."""
+        seen = stamp - self.first_seen.get(a.obstacle.id, stamp)
+        if self.costmap is None or seen < self.p.map_confirm + 0.5:
+            return False
+        ob = a.obstacle
+        reach = ob.radius + self.p.map_resolution
+        ring = np.array([[ob.position[0] + dx, ob.position[1] + dy]
+                         for dx in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
+                         for dy in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
+                         if dx * dx + dy * dy <= reach * reach])
+        return bool(self.costmap.lethal_at(ring).any())
+
+    def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
+        """Beyond the paper: whether the straight way to ``target`` is free on the map's
+        fine, inflated grid. The paper's (b) test reads an obstacle's cell box S_k (0.5 m
+        cells), which can close a 1 m gap between two walls; an obstacle the map has
+        confirmed is judged on the map instead. ``to_goal``: the way is checked as far
+        as the (b) test looks, past the look-ahead point along the path."""
+        if self.costmap is None or not self.p.use_map:
+            return False
+        offset = target - robot
+        distance = float(np.hypot(*offset))
+        if distance < 1e-9:
+            return True
+        direction = offset / distance
+        length = distance
+        if to_goal:
+            length = max(distance, min(self._straight_ahead(robot, direction),
+                                       self.p.window_radius))
+        first = min(self.p.map_resolution, length)
+        samples = path_points(robot + direction * first, direction, length - first,
+                              self.p.map_resolution / 2)
+        return not bool(self.costmap.blocked_at(samples).any())
 
     # -- responses ---------------------------------------------------------------------
 
@@ -423,24 +530,14 @@ class Planner:
 
     # -- the cycle ---------------------------------------------------------------------
 
-    def step(
-        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float = 0.0
+    def local_layer(
+        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float
     ) -> Decision:
+        """The paper's local layer toward the look-ahead point on the global path:
+        assess every obstacle in the window, respond per scenario letter, plan a Morphin
+        detour when one is needed, check the speed against the movers, steer."""
         p = self.p
-        for ob in obstacles:
-            self.first_seen.setdefault(ob.id, stamp)
-        live = {ob.id for ob in obstacles}
-        self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
-        self.sides = {i: side for i, side in self.sides.items() if i in live}
         robot = np.array(pose[:2], dtype=np.float64)
-        if self.start is None:
-            self.start = robot.copy()
-            self.global_cells = cells_on_segment(self.start, self.goal, p.cell)
-        goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        if float(np.hypot(*(self.goal - robot))) <= p.goal_tolerance / 2:
-            self.detour = None
-            return Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0)
-
         in_window = [o for o in obstacles
                      if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
         path_target = self.path_target(robot, self._statics(in_window))
@@ -459,8 +556,12 @@ class Planner:
         notes = self._assess_all(robot, target, in_window, slack, to_goal=self.detour is None)
         # A "new" obstacle has been seen once: it is answered from the next scan on, when
         # its type is known (the motor bridge's stop zone covers the meantime).
+        # The map may clear the way to the target (the path's look-ahead point, or the
+        # detour's sub-target); whether a detour may end is still the boxes' call.
+        clear = self._map_clear(robot, target, to_goal=self.detour is None)
         threats = [self._sticky(a) for a in notes
-                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)]
+                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
+                   and not (a.letter == "b" and clear and self._mapped(a, stamp))]
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
@@ -580,3 +681,245 @@ class Planner:
             self.detour.obstacle if self.detour is not None else None)
         kind = lead.obstacle.kind if lead is not None else None
         return Decision(v, omega, (tx, ty), letter, action, obstacle, kind, speed, tuple(notes))
+
+    # -- the cycle, stage by stage -----------------------------------------------------
+
+    def step(
+        self,
+        pose: tuple[float, float, float],
+        obstacles: list[Obstacle],
+        stamp: float = 0.0,
+        scan: ScanData | None = None,
+    ) -> Decision:
+        """One decision per scan: map -> global path -> (recovery, or the local layer:
+        assess, respond, detour, speed and safety) -> stop zone -> command."""
+        p = self.p
+        for ob in obstacles:
+            self.first_seen.setdefault(ob.id, stamp)
+        live = {ob.id for ob in obstacles}
+        self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
+        self.sides = {i: side for i, side in self.sides.items() if i in live}
+        robot = np.array(pose[:2], dtype=np.float64)
+        if self.start is None:
+            self.start = robot.copy()
+            self._set_path(np.vstack([self.start, self.goal]), "start")
+        self._remember_trail(robot)
+        goal_xy = (float(self.goal[0]), float(self.goal[1]))
+        if float(np.hypot(*(self.goal - robot))) <= p.goal_tolerance / 2:
+            self.detour = None
+            return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
+        if self.recovery.unreachable:
+            return self._record(Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0))
+
+        self.update_map(pose, obstacles, scan, stamp)
+        self.update_path(robot, stamp)
+        decision = self.recover(pose, stamp, scan)
+        if decision is None:
+            decision = self.local_layer(pose, obstacles, stamp)
+            if decision.action == "stop" and decision.scenario == "b":
+                self.replan_asked = "no way round"  # the local layer found no detour
+            decision = self.guard_stop_zone(decision, pose, scan)
+            waiting = decision.action in ("stop", "slow") and decision.kind == "dynamic"
+            if p.recovery and self.recovery.watch(stamp, self.to_go(robot), waiting,
+                                                  decision.refused):
+                way = self.plan is None or self.plan.found
+                step = self.recovery.start_next(stamp, pose, way_known=way)
+                if step is None:
+                    decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
+                else:
+                    self.detour = None
+                    decision = self.recover(pose, stamp, scan) or decision
+        return self._record(decision)
+
+    def _record(self, decision: Decision) -> Decision:
+        self.last_v = decision.v
+        return decision
+
+    def _remember_trail(self, robot: Vec) -> None:
+        if not self.trail or math.dist(self.trail[-1], robot) >= 0.05:
+            self.trail.append((float(robot[0]), float(robot[1])))
+            del self.trail[:-400]
+
+    # -- stage: the map ----------------------------------------------------------------
+
+    def update_map(self, pose: tuple[float, float, float], obstacles: list[Obstacle],
+                   scan: ScanData | None, stamp: float) -> None:
+        """Ray-trace the scan into the occupancy grid; the returns on movers (tracks
+        typed dynamic) are left out."""
+        p = self.p
+        if not p.use_map:
+            return
+        if self.costmap is None:
+            assert self.start is not None
+            start = (float(self.start[0]), float(self.start[1]))
+            goal = (float(self.goal[0]), float(self.goal[1]))
+            self.costmap = Costmap(
+                start, goal, resolution=p.map_resolution, decay=p.map_decay,
+                inflation=p.robot_radius + p.safety_margin,
+                confirm=p.map_confirm, padding=p.map_padding, max_size=p.map_max_size)
+        if scan is None:
+            return
+        movers = [(o.position[0], o.position[1], o.radius) for o in obstacles
+                  if o.kind == "dynamic"]
+        self.costmap.update(scan, stamp, movers)
+
+    # -- stage: the global path --------------------------------------------------------
+
+    def to_go(self, robot: Vec) -> float:
+        """Distance still to go along the global path (plus the way back onto it), m."""
+        if self.path is None:
+            return float(np.hypot(*(self.goal - robot)))
+        s0, off = project(self.path, robot)
+        return float(arc_lengths(self.path)[-1]) - s0 + off
+
+    def replan_reason(self, robot: Vec, stamp: float) -> str | None:
+        """Why the global path must be planned again now, or None. Obstacles in the
+        window are the local layer's; the path is planned again when the local layer
+        asks (no way round), when the robot has left the path (after a detour), or when
+        the map blocks the path beyond the window."""
+        p = self.p
+        if self.replan_asked is not None:
+            return self.replan_asked
+        if self.path is None:
+            return "no path"
+        if self.costmap is None:
+            return None
+        if self.plan is not None and not self.plan.found:
+            # No way known: keep the old path and look again (the map changes).
+            return "retry" if stamp - self.last_replan >= p.replan_period else None
+        if self.detour is not None:
+            return None
+        s0, off = project(self.path, robot)
+        if off > p.path_deviation:
+            return "off the path"
+        if stamp - self.last_replan < p.replan_period:
+            return None
+        beyond = first_blocked(self.costmap, self.path, s0 + p.window_radius,
+                               p.map_resolution)
+        if beyond is not None:
+            return "blocked beyond the window"
+        return None
+
+    def update_path(self, robot: Vec, stamp: float) -> None:
+        """Plan the global path on the map when it is needed (see ``replan_reason``)."""
+        if self.costmap is None:
+            return
+        reason = self.replan_reason(robot, stamp)
+        if reason is None:
+            return
+        self.replan_asked = None
+        self.last_replan = stamp
+        plan = plan_path(self.costmap, robot, self.goal, reason)
+        self.plan = plan
+        if not plan.found:
+            return  # keep driving the old path; recovery takes it from here
+        before = self.to_go(robot)
+        self._set_path(plan.points, reason)
+        after = self.to_go(robot)
+        if after > before:  # a longer way is no lack of progress on the old one
+            self.recovery.check_to_go = max(self.recovery.check_to_go, after)
+
+    # -- stage: recovery ---------------------------------------------------------------
+
+    def _known_free_behind(self, pose: tuple[float, float, float]) -> bool:
+        """Whether reversing ``backup_distance`` straight back stays where the robot's
+        centre has already been (within half its radius): the laser does not see
+        behind, the trail is the only knowledge of that space."""
+        p = self.p
+        if len(self.trail) < 2:
+            return False
+        back = np.array([-math.cos(pose[2]), -math.sin(pose[2])])
+        here = np.asarray(pose[:2], dtype=np.float64)
+        samples = path_points(here, back, p.backup_distance, p.robot_radius / 4)
+        trail = np.asarray(self.trail, dtype=np.float64)
+        gaps = np.hypot(samples[:, None, 0] - trail[None, :, 0],
+                        samples[:, None, 1] - trail[None, :, 1]).min(axis=1)
+        return bool((gaps <= p.robot_radius / 2).all())
+
+    def recover(self, pose: tuple[float, float, float], stamp: float,
+                scan: ScanData | None) -> Decision | None:
+        """The command of the recovery step under way, or None when none is."""
+        r = self.recovery
+        p = self.p
+        robot = np.array(pose[:2], dtype=np.float64)
+        goal_xy = (float(self.goal[0]), float(self.goal[1]))
+        no_way = self.plan is not None and not self.plan.found
+        if r.active is None and no_way and r.level >= len(STEPS):
+            # Every recovery step tried and still no way on the map: give up, clearly.
+            r.unreachable = True
+            return Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
+        act = r.active
+        if act is None:
+            return None
+        elapsed = stamp - act.started
+
+        def done() -> None:
+            r.finish(stamp, self.to_go(robot))
+
+        if act.step == "replan":
+            if self.costmap is not None:
+                # Forget all the map has not seen in the last second: what is in view now
+                # is rebuilt by the next scans, stale marks behind are dropped.
+                self.costmap.forget_older_than(stamp - 1.0)
+                self.last_replan = -math.inf
+                self.replan_asked = "recovery"
+                self.update_path(robot, stamp)
+            done()
+            return Decision(0.0, 0.0, goal_xy, "a", "replan", None, None, 0.0)
+        if act.step == "spin":
+            turn = math.atan2(math.sin(pose[2] - act.last_heading),
+                              math.cos(pose[2] - act.last_heading))
+            act.turned += abs(turn)
+            act.last_heading = pose[2]
+            bound = r.s.spin_angle / (0.5 * p.max_omega) + 5.0
+            if act.turned >= r.s.spin_angle or elapsed > bound:
+                done()
+                self.replan_asked = "after spin"
+                return None
+            return Decision(0.0, p.max_omega, goal_xy, "a", "spin", None, None, 0.0)
+        if act.step == "back_up":
+            moved = math.dist(act.pose[:2], pose[:2])
+            bound = 2.0 * r.s.backup_distance / r.s.backup_speed + 2.0
+            if elapsed == 0.0 and not self._known_free_behind(pose):
+                done()  # nothing known behind: skip the step (the wait comes next)
+                return Decision(0.0, 0.0, goal_xy, "a", "back_up", None, None, 0.0)
+            if moved >= r.s.backup_distance or elapsed > bound:
+                done()
+                self.replan_asked = "after back-up"
+                return None
+            return Decision(-r.s.backup_speed, 0.0, goal_xy, "a", "back_up", None, None,
+                            r.s.backup_speed)
+        # wait
+        if elapsed >= r.s.wait_time:
+            done()
+            self.replan_asked = "after wait"
+            return None
+        return Decision(0.0, 0.0, goal_xy, "a", "wait", None, None, 0.0)
+
+    # -- stage: the stop zone ----------------------------------------------------------
+
+    def guard_stop_zone(self, d: Decision, pose: tuple[float, float, float],
+                        scan: ScanData | None) -> Decision:
+        """Never command forward motion into the motor bridge's stop zone (the same
+        geometry, the same pure check): turn in place toward the free heading nearest
+        the target instead."""
+        p = self.p
+        if scan is None or d.v <= 0.0 or not p.stop_zone:
+            return d
+        ranges = scan.ranges.astype(np.float32)
+        if not p.blocks(ranges, scan.angle_min, scan.angle_increment, scan.range_max,
+                        max(d.v, self.last_v), p.robot_radius):
+            return d
+        error = math.atan2(d.target[1] - pose[1], d.target[0] - pose[0]) - pose[2]
+        error = math.atan2(math.sin(error), math.cos(error))
+        turns = sorted((math.radians(g) for g in range(-90, 91, 10)),
+                       key=lambda g: (abs(g - error), g))
+        free = next((g for g in turns if abs(g) > 1e-9 and not p.blocks(
+            ranges, scan.angle_min - g, scan.angle_increment, scan.range_max, p.cruise_speed,
+            p.robot_radius)), None)
+        goal_side = error if abs(error) > 1e-3 else 1.0
+        g = free if free is not None else math.copysign(math.pi / 2, goal_side)
+        omega = math.copysign(max(min(abs(p.heading_gain * g), p.max_omega),
+                                  0.3 * p.max_omega), g)
+        return dataclasses.replace(d, v=0.0, omega=omega, refused=True,
+                                   action="safety_stop" if d.action == "keep" else d.action)

@@ -1,4 +1,5 @@
-"""Distance to the goal around the standing obstacles seen so far (pure, no I/O).
+"""Shortest ways on an 8-connected grid: the distance to the goal around the standing
+obstacles seen so far, and the grid search the global path uses (pure, no I/O).
 
 Beyond the paper. Morphin's Delta L term measures how far a candidate's end is from the
 target. Measured in a straight line, it favours ends that lie close to the goal behind
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from zenav.services.planner.prediction import gap_to_boxes
@@ -41,6 +42,47 @@ class DistanceField:
         return float(self.distance[i, j]) + 0.0
 
 
+def grid_graph(free: npt.NDArray[np.bool_], resolution: float,
+               cost: npt.NDArray[np.float64] | None = None) -> csr_matrix:
+    """The 8-connected graph of the free cells of a (nx, ny) grid, edge weights in m
+    (1 or sqrt 2 cells, times 1 + the mean ``cost`` of the two cells when given);
+    node ``i * ny + j`` is cell (i, j)."""
+    nx, ny = free.shape
+    index = np.arange(nx * ny).reshape(nx, ny)
+    rows, cols, weights = [], [], []
+    for di, dj, w in _STEPS:
+        a = index[max(0, -di): nx - max(0, di), max(0, -dj): ny - max(0, dj)]
+        b = index[max(0, di): nx - max(0, -di) or None, max(0, dj): ny - max(0, -dj) or None]
+        fa = free[max(0, -di): nx - max(0, di), max(0, -dj): ny - max(0, dj)]
+        fb = free[max(0, di): nx - max(0, -di) or None, max(0, dj): ny - max(0, -dj) or None]
+        ok = fa & fb
+        rows.append(a[ok])
+        cols.append(b[ok])
+        if cost is None:
+            weights.append(np.full(int(ok.sum()), w * resolution))
+        else:
+            flat = cost.ravel()
+            weights.append(w * resolution * (1.0 + (flat[a[ok]] + flat[b[ok]]) / 2.0))
+    r = np.concatenate(rows)
+    c = np.concatenate(cols)
+    return coo_matrix((np.concatenate(weights), (r, c)), shape=(nx * ny, nx * ny)).tocsr()
+
+
+def grid_distances(
+    free: npt.NDArray[np.bool_], source: tuple[int, int], resolution: float,
+    cost: npt.NDArray[np.float64] | None = None,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+    """Shortest-way distance (m) from cell ``source`` to every cell of the grid over its
+    free cells (inf where cut off), and each cell's predecessor toward the source
+    (-9999 where none), both (nx, ny)."""
+    nx, ny = free.shape
+    graph = grid_graph(free, resolution, cost)
+    dist, pred = dijkstra(graph, directed=False, indices=source[0] * ny + source[1],
+                          return_predecessors=True)
+    return (np.asarray(dist, dtype=np.float64).reshape(nx, ny),
+            np.asarray(pred, dtype=np.int32).reshape(nx, ny))
+
+
 def distance_field(
     goal: Vec,
     lows: Vec,
@@ -59,29 +101,14 @@ def distance_field(
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     centres = np.column_stack([gx.ravel(), gy.ravel()])
     free = gap_to_boxes(centres, lows, highs) >= clearance
-    index = np.arange(nx * ny).reshape(nx, ny)
-    rows, cols, weights = [], [], []
-    free2 = free.reshape(nx, ny)
-    for di, dj, w in _STEPS:
-        a = index[max(0, -di): nx - max(0, di), max(0, -dj): ny - max(0, dj)]
-        b = index[max(0, di): nx - max(0, -di) or None, max(0, dj): ny - max(0, -dj) or None]
-        fa = free2[max(0, -di): nx - max(0, di), max(0, -dj): ny - max(0, dj)]
-        fb = free2[max(0, di): nx - max(0, -di) or None, max(0, dj): ny - max(0, -dj) or None]
-        ok = fa & fb
-        rows.append(a[ok])
-        cols.append(b[ok])
-        weights.append(np.full(int(ok.sum()), w * resolution))
-    r = np.concatenate(rows)
-    c = np.concatenate(cols)
-    graph = coo_matrix((np.concatenate(weights), (r, c)), shape=(nx * ny, nx * ny)).tocsr()
     origin = np.array([xs[0], ys[0]])
     goal_cell = np.rint((goal - origin) / resolution).astype(int)
     goal_cell = np.clip(goal_cell, 0, [nx - 1, ny - 1])
-    start = int(index[goal_cell[0], goal_cell[1]])
+    start = int(goal_cell[0] * ny + goal_cell[1])
     if not free[start]:  # the goal cell is inside an inflated obstacle: nearest free one
         candidates = np.flatnonzero(free)
         if len(candidates) == 0:
             return DistanceField(origin, resolution, np.full((nx, ny), math.inf))
         start = int(candidates[np.argmin(np.hypot(*(centres[candidates] - goal).T))])
-    dist = dijkstra(graph, directed=False, indices=start)
-    return DistanceField(origin, resolution, np.asarray(dist, dtype=np.float64).reshape(nx, ny))
+    dist, _ = grid_distances(free.reshape(nx, ny), (start // ny, start % ny), resolution)
+    return DistanceField(origin, resolution, dist)

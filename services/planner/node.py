@@ -1,15 +1,29 @@
-"""Planner service: tracks in (they carry the robot pose at scan time), one velocity
-command per scan out, plus an event for every decision that changes what the robot does
-and the planner's state for monitors."""
+"""Planner service: tracks in (they carry the robot pose at scan time) and the scan of
+the same stamp (for the map and the stop zone), one velocity command per scan out, plus
+an event for every decision that changes what the robot does, the planner's state for
+monitors, the global path whenever it changes and the map once a second.
+
+Joining the two halves of a stamp: a decision is made once both the track list and the
+scan of one stamp are in, whichever came first, so the result does not depend on their
+arrival order. A track list whose scan has not come within ``scan_wait`` wall seconds
+(or is overtaken by a newer track list) is decided on without a map update or a stop
+zone check; the motor bridge's own stop zone still holds.
+"""
 
 from __future__ import annotations
 
+import asyncio
 from collections import deque
+
+import numpy as np
 
 from zenav.schemas import keys
 from zenav.schemas.messages import (
     Action,
+    GlobalPath,
+    LaserScan,
     ObstacleKind,
+    OccupancyMap,
     PlannerEvent,
     PlannerState,
     ScenarioLetter,
@@ -17,6 +31,7 @@ from zenav.schemas.messages import (
     VelocityCommand,
 )
 from zenav.services.node import Node, StampGate
+from zenav.services.planner.costmap import ScanData
 from zenav.services.planner.decide import Decision, Planner
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
@@ -29,6 +44,12 @@ def obstacles_of(tracks: TrackList) -> list[Obstacle]:
                  radius=t.radius, cells=t.cells)
         for t in tracks.tracks
     ]
+
+
+def scan_data(scan: LaserScan, pose: tuple[float, float, float]) -> ScanData:
+    """The scan as the planner's map reads it, with the pose it was taken from."""
+    return ScanData(pose, scan.ranges.astype(np.float64), scan.angle_min, scan.angle_increment,
+                    scan.range_max, scan.range_min)
 
 
 EventRow = tuple[ScenarioLetter, Action, int | None, ObstacleKind | None, str]
@@ -79,9 +100,14 @@ class EventLog:
         return found
 
 
+SCANS_KEPT = 8
+"""Scans kept while their track lists are on the way."""
+
+
 class Service:
     def __init__(self, node: Node, params: Params) -> None:
         self.node = node
+        self.params = params
         self.planner = Planner(params)
         self.log = EventLog(params.horizon)
         self.commands = node.publisher(keys.CMD_VEL, VelocityCommand, urgent=True)
@@ -90,15 +116,51 @@ class Service:
         self.history: deque[bytes] = deque(maxlen=EVENTS_KEPT)
         node.bus.declare_queryable(node.keys.of(keys.EVENT_HISTORY), lambda: list(self.history))
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
+        self.paths = node.publisher(keys.PATH, GlobalPath, reliable=True)
+        self.maps = node.publisher(keys.MAP, OccupancyMap)
         self.gate = StampGate(node, keys.TRACKS)
+        self.scans: dict[float, LaserScan] = {}  # the latest few, by stamp
+        self.pending: TrackList | None = None  # a track list waiting for its scan
+        self.timer: asyncio.TimerHandle | None = None
+        self.path_sent = 0  # the planner's plan_count last published
+        self.map_sent = -1.0  # stamp of the last map published
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
+        node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
+
+    def on_scan(self, scan: LaserScan) -> None:
+        self.scans[scan.stamp] = scan
+        while len(self.scans) > SCANS_KEPT:
+            del self.scans[min(self.scans)]
+        if self.pending is not None and self.pending.stamp == scan.stamp:
+            self.decide(self.pending, scan)
 
     def on_tracks(self, tracks: TrackList) -> None:
         if not self.gate.admit(tracks.stamp, self.commands):
             return
+        if self.pending is not None:  # overtaken before its scan came: decide it now
+            self.decide(self.pending, None)
+        scan = self.scans.get(tracks.stamp)
+        if scan is not None:
+            self.decide(tracks, scan)
+            return
+        self.pending = tracks
+        stamp = tracks.stamp
+        self.timer = asyncio.get_running_loop().call_later(
+            self.params.scan_wait, self._scan_late, stamp)
+
+    def _scan_late(self, stamp: float) -> None:
+        if self.pending is not None and self.pending.stamp == stamp:
+            self.decide(self.pending, None)
+
+    def decide(self, tracks: TrackList, scan: LaserScan | None) -> None:
+        self.pending = None
+        if self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
         pose = tracks.pose
-        decision = self.planner.step((pose.x, pose.y, pose.heading), obstacles_of(tracks),
-                                     tracks.stamp)
+        xyh = (pose.x, pose.y, pose.heading)
+        decision = self.planner.step(xyh, obstacles_of(tracks), tracks.stamp,
+                                     None if scan is None else scan_data(scan, xyh))
         for letter, action, obstacle, kind, detail in self.log.events(decision):
             self.history.append(self.events.publish(PlannerEvent(
                 stamp=tracks.stamp, seq=self.events.next_seq(), obstacle=obstacle,
@@ -108,6 +170,25 @@ class Service:
         self.state.publish(PlannerState(
             stamp=tracks.stamp, seq=self.state.next_seq(), scenario=decision.scenario,
             action=decision.action, target=decision.target, speed=decision.speed))
+        self.publish_path_and_map(tracks.stamp)
+
+    def publish_path_and_map(self, stamp: float) -> None:
+        planner = self.planner
+        if planner.path is not None and planner.plan_count != self.path_sent:
+            self.path_sent = planner.plan_count
+            reason = planner.plan.reason if planner.plan is not None else "start"
+            self.paths.publish(GlobalPath(stamp=stamp, seq=self.paths.next_seq(),
+                                          points=planner.path, reason=reason[:100]))
+        costmap = planner.costmap
+        if costmap is not None and stamp - self.map_sent >= self.params.map_period:
+            self.map_sent = stamp
+            values = costmap.values()
+            nx, ny = values.shape
+            self.maps.publish(OccupancyMap(
+                stamp=stamp, seq=self.maps.next_seq(),
+                origin=(float(costmap.origin[0]), float(costmap.origin[1])),
+                resolution=costmap.resolution, width=nx, height=ny,
+                cells=np.ascontiguousarray(values.T).ravel()))
 
 
 if __name__ == "__main__":

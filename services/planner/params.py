@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from zenav.services.mission import CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
+from zenav.services.motor_bridge.stop_zone import StopZoneParams
 
 
 class MissionParams(BaseModel):
@@ -37,8 +39,9 @@ class MissionParams(BaseModel):
     )
 
 
-class Params(MissionParams):
-    """The paper planner's parameters."""
+class Params(MissionParams, StopZoneParams):
+    """The paper planner's parameters. The stop zone's geometry (``stop_zone``,
+    ``zone_*``, ``decel``) is the motor bridge's own model, included, not copied."""
 
     heading_gain: float = Field(1.5, gt=0, description="turn rate per rad of heading error, 1/s")
     safety_margin: float = Field(
@@ -148,3 +151,82 @@ class Params(MissionParams):
         0.1, ge=0, description="extra clearance the direct way must have before a detour "
         "is given up, m"
     )
+
+    # --- the map (costmap.py) ---------------------------------------------------------
+    use_map: bool = Field(
+        True, description="beyond the paper: build an occupancy map from the scans and "
+        "follow a global path planned on it (paper: False, the straight start-goal line)"
+    )
+    map_resolution: float = Field(
+        0.1, gt=0, description="map cell side, m: half the robot radius, so a 1 m gap "
+        "between two walls stays passable after inflation, and the grid search over a "
+        "20 m square stays near 40,000 cells"
+    )
+    map_decay: float = Field(
+        60.0, gt=0, description="a cell not seen for this long is unknown again, s: longer "
+        "than the tracks' 30 s memory, so the map outlives what the local layer forgets"
+    )
+    map_confirm: float = Field(
+        1.0, ge=0, description="a return must stay in its cell this long before the map "
+        "counts it as an obstacle, s: a mover beyond perception's window (untyped) moves on "
+        "before that, a standing obstacle is confirmed in ten scans"
+    )
+    map_padding: float = Field(
+        3.0, gt=0, description="margin of the grid round start, goal and every return, m; "
+        "also the step it grows by"
+    )
+    map_max_size: float = Field(200.0, gt=0, description="largest grid side, m")
+    map_period: float = Field(1.0, gt=0, description="s between two published maps")
+    scan_wait: float = Field(
+        1.0, gt=0, description="wall s the planner waits for the scan of a track list's "
+        "stamp before deciding without a map update; in real time the next track list "
+        "(0.1 s later at 10 Hz) ends the wait sooner, so this bound matters in lockstep "
+        "runs, where it keeps a loaded machine from changing the result"
+    )
+
+    # --- the global path (global_path.py) ---------------------------------------------
+    path_deviation: float = Field(
+        0.3, gt=0, description="the path is planned again when the robot is farther than "
+        "this from it (after a detour, say), m"
+    )
+    replan_period: float = Field(
+        1.0, ge=0, description="shortest time between two re-plans that the map alone "
+        "asks for (a blocked path), s"
+    )
+
+    # --- recovery (recovery.py) -------------------------------------------------------
+    recovery: bool = Field(
+        True, description="beyond the paper: watch progress and recover (replan, spin, back "
+        "up, wait; unreachable) when it stalls (paper: False)"
+    )
+    progress_distance: float = Field(
+        0.5, gt=0, description="distance to go that must be gained within "
+        "progress_timeout, m (Nav2's progress checker: 0.5 m)"
+    )
+    progress_timeout: float | None = Field(
+        None, gt=0, description="s; default: the longer of 10 s (Nav2's) and the time to "
+        "cover progress_distance at a fifth of the cruise speed (25 s at 0.1 m/s)"
+    )
+    stop_zone_timeout: float = Field(
+        5.0, gt=0, description="s of forward motion refused by the stop zone before recovery"
+    )
+    wait_allowance: float = Field(
+        40.0, ge=0, description="s of waiting for a mover ((e), (g)) in a row that do not "
+        "count against progress"
+    )
+    spin_deg: float = Field(360.0, gt=0, description="recovery spin: turn in place, deg")
+    backup_distance: float = Field(0.3, ge=0, description="recovery back-up: reverse, m")
+    backup_speed: float = Field(0.05, gt=0, description="recovery back-up speed, m/s")
+    wait_time: float = Field(5.0, ge=0, description="recovery wait: stand still, s")
+    recovery_rounds: int = Field(
+        2, ge=1, description="rounds of the four recovery steps without progress, with no "
+        "way to the goal on the map, before the goal is declared unreachable"
+    )
+
+    def effective_progress_timeout(self) -> float:
+        if self.progress_timeout is not None:
+            return self.progress_timeout
+        return max(10.0, self.progress_distance / (0.2 * self.cruise_speed))
+
+    def spin_angle(self) -> float:
+        return math.radians(self.spin_deg)

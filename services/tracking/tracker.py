@@ -260,7 +260,7 @@ class Tracker:
                     self._correct(t, m)
             was_static = t.kind == "static"
             if clusters.moved is not None:
-                moved = max(float(clusters.moved[c]) for c in members[ti])
+                moved = max(self._moved_since_born(clusters, c, t.born) for c in members[ti])
                 if moved >= p.moved_threshold:
                     t.last_moved = stamp
             if smoothed:
@@ -581,6 +581,18 @@ class Tracker:
         t.p00 = (1.0 - k0) * p00
         t.p01 = (1.0 - k0) * p01
         t.p11 = p11 - k1 * p01
+
+    @staticmethod
+    def _moved_since_born(clusters: Clusters, c: int, born: float) -> float:
+        """Cluster ``c``'s motion score against the earlier scans taken since the track
+        was first seen (``born``). An obstacle that appears out of nothing occupies
+        space the scans before it saw empty, without having moved: the paper calls it
+        new, and it is judged from its own next scans, not from the empty space before.
+        """
+        if clusters.moved_each is None or clusters.moved_refs is None:
+            return float(clusters.moved[c]) if clusters.moved is not None else 0.0
+        since = np.isfinite(clusters.moved_refs) & (clusters.moved_refs >= born - 1e-9)
+        return float(clusters.moved_each[c][since].max(initial=0.0))
 
     def _smoothed_kind(self, t: _State, stamp: float, cue: bool) -> Kind:
         """Type from the free-space motion cue when perception measures it, else from the

@@ -1,0 +1,258 @@
+"""A world-frame occupancy grid built from the scans, and its inflation (pure, no I/O).
+
+Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
+
+- every beam clears the cells it passes through (ray tracing, all beams at once: the
+  points every half cell along each beam, up to its return or the laser's reach);
+- the cell of each return is marked occupied, unless the return falls inside the disc
+  of a track typed dynamic (movers are the local layer's business, not the map's); it
+  counts as an obstacle once it has stayed occupied for ``confirm`` seconds, so a mover
+  beyond perception's window (no track, no type) leaves no wake of marks: its front moves
+  on to new cells before they are confirmed, and the beams clear the cells it left;
+- a cell keeps what it was last seen as for ``decay`` seconds, then is unknown again;
+- the planner treats unknown cells as free (optimistic, as Nav2's ``allow_unknown``);
+- occupied cells are inflated by the robot radius plus a margin with a Euclidean distance
+  transform (scipy.ndimage), so a path through the free cells keeps the robot's disc
+  clear of everything the map holds.
+
+The grid covers start and goal with padding at first and grows (by whole blocks) when
+the robot or a return falls outside it, up to ``max_size`` metres a side.
+
+Cells are indexed ``[ix, iy]``; cell (0, 0) spans [origin, origin + resolution) in x and y.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.ndimage import distance_transform_edt
+
+Vec = npt.NDArray[np.float64]
+BoolGrid = npt.NDArray[np.bool_]
+
+UNKNOWN, FREE, OCCUPIED = -1, 0, 100
+"""Cell values in :meth:`Costmap.values` (those of ROS nav_msgs/OccupancyGrid)."""
+
+
+@dataclass(frozen=True)
+class ScanData:
+    """One scan in the global frame's terms: the pose it was taken from and the beams."""
+
+    pose: tuple[float, float, float]
+    ranges: npt.NDArray[np.float64]  # m; range_max = no return
+    angle_min: float  # rad, relative to the heading
+    angle_increment: float  # rad
+    range_max: float  # m
+    range_min: float = 0.0
+
+
+class Costmap:
+    """Occupancy from the scans, with decay; inflated on demand."""
+
+    def __init__(
+        self,
+        lo: tuple[float, float],
+        hi: tuple[float, float],
+        *,
+        resolution: float,
+        decay: float,
+        inflation: float,
+        confirm: float = 0.0,
+        padding: float,
+        max_size: float,
+    ) -> None:
+        self.resolution = resolution
+        self.decay = decay
+        self.confirm = confirm
+        self.inflation = inflation
+        self.padding = padding
+        self.max_size = max_size
+        x0 = math.floor((min(lo[0], hi[0]) - padding) / resolution) * resolution
+        y0 = math.floor((min(lo[1], hi[1]) - padding) / resolution) * resolution
+        nx = math.ceil((max(lo[0], hi[0]) + padding - x0) / resolution)
+        ny = math.ceil((max(lo[1], hi[1]) + padding - y0) / resolution)
+        self.origin = np.array([x0, y0], dtype=np.float64)
+        self.seen = np.full((nx, ny), -math.inf)  # stamp a cell was last observed
+        self.occupied = np.zeros((nx, ny), dtype=bool)  # what it was then
+        self.hit_since = np.full((nx, ny), math.inf)  # start of its current occupied spell
+        self.now = -math.inf
+        self.version = 0  # bumped whenever the occupied set may have changed
+        self._inflated: tuple[int, BoolGrid, BoolGrid] | None = None
+        self._gap: npt.NDArray[np.float64] | None = None
+
+    # -- geometry ----------------------------------------------------------------------
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        nx, ny = self.seen.shape
+        return nx, ny
+
+    def cell_of(self, points: Vec) -> npt.NDArray[np.int64]:
+        """(n, 2) integer cell indices of (n, 2) points (may lie outside the grid)."""
+        return np.floor((np.asarray(points, dtype=np.float64) - self.origin)
+                        / self.resolution).astype(np.int64)
+
+    def centre_of(self, cells: npt.NDArray[np.int64]) -> Vec:
+        return self.origin + (np.asarray(cells, dtype=np.float64) + 0.5) * self.resolution
+
+    def inside(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
+        nx, ny = self.shape
+        return np.asarray((cells[:, 0] >= 0) & (cells[:, 0] < nx)
+                          & (cells[:, 1] >= 0) & (cells[:, 1] < ny))
+
+    def grow_to(self, points: Vec, margin: float) -> None:
+        """Enlarge the grid so ``points`` (n, 2) lie at least ``margin`` m inside it (in
+        blocks of ``padding``), never beyond ``max_size`` a side."""
+        if len(points) == 0:
+            return
+        r = self.resolution
+        nx, ny = self.shape
+        lo = np.min(points, axis=0) - margin
+        hi = np.max(points, axis=0) + margin
+        add_lo = np.maximum(np.ceil((self.origin - lo) / self.padding), 0) * self.padding
+        top = self.origin + np.array([nx, ny]) * r
+        add_hi = np.maximum(np.ceil((hi - top) / self.padding), 0) * self.padding
+        if not (add_lo.any() or add_hi.any()):
+            return
+        cells_lo = np.rint(add_lo / r).astype(int)
+        cells_hi = np.rint(add_hi / r).astype(int)
+        limit = math.ceil(self.max_size / r)
+        for axis, size in enumerate((nx, ny)):
+            over = size + cells_lo[axis] + cells_hi[axis] - limit
+            if over > 0:  # keep the side nearer the points; drop the growth that overflows
+                cut_hi = min(cells_hi[axis], over)
+                cells_hi[axis] -= cut_hi
+                cells_lo[axis] = max(cells_lo[axis] - (over - cut_hi), 0)
+        if not (cells_lo.any() or cells_hi.any()):
+            return
+        pad = ((int(cells_lo[0]), int(cells_hi[0])), (int(cells_lo[1]), int(cells_hi[1])))
+        self.seen = np.pad(self.seen, pad, constant_values=-math.inf)
+        self.occupied = np.pad(self.occupied, pad, constant_values=False)
+        self.hit_since = np.pad(self.hit_since, pad, constant_values=math.inf)
+        self.origin = self.origin - cells_lo * r
+        self.version += 1
+        self._inflated = None
+
+    # -- updates -----------------------------------------------------------------------
+
+    def update(self, scan: ScanData, stamp: float,
+               movers: list[tuple[float, float, float]] | None = None) -> None:
+        """Ray-trace one scan taken at ``stamp``. ``movers``: (x, y, radius) discs of the
+        tracks typed dynamic; returns inside them are not marked."""
+        self.now = max(self.now, stamp)
+        x, y, heading = scan.pose
+        ranges = np.asarray(scan.ranges, dtype=np.float64)
+        angles = heading + scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+        hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
+        ends = np.column_stack([x + ranges * np.cos(angles), y + ranges * np.sin(angles)])
+        self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
+                     self.padding / 2)
+        # Free space: every half cell along each beam, stopping half a cell short of
+        # its return (a beam with no return clears up to its reach).
+        step = self.resolution / 2
+        reach = np.where(hit, ranges - step, ranges)
+        count = math.ceil(float(reach.max(initial=0.0)) / step) + 1
+        s = np.arange(count) * step  # (k,)
+        along = s[None, :] <= reach[:, None]  # (beams, k)
+        px = x + s[None, :] * np.cos(angles)[:, None]
+        py = y + s[None, :] * np.sin(angles)[:, None]
+        free_points = np.column_stack([px[along], py[along]])
+        cells = self.cell_of(free_points)
+        cells = cells[self.inside(cells)]
+        self.seen[cells[:, 0], cells[:, 1]] = stamp
+        cleared = self.occupied[cells[:, 0], cells[:, 1]]
+        self.occupied[cells[:, 0], cells[:, 1]] = False
+        # Hits, except those on a mover.
+        marks = ends[hit]
+        if movers and len(marks):
+            discs = np.asarray(movers, dtype=np.float64).reshape(-1, 3)
+            gap = np.hypot(marks[:, None, 0] - discs[None, :, 0],
+                           marks[:, None, 1] - discs[None, :, 1]) - discs[None, :, 2]
+            marks = marks[(gap > self.resolution).all(axis=1)]
+        hits = self.cell_of(marks)
+        hits = hits[self.inside(hits)]
+        newly = ~self.occupied[hits[:, 0], hits[:, 1]]
+        self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
+        self.seen[hits[:, 0], hits[:, 1]] = stamp
+        self.occupied[hits[:, 0], hits[:, 1]] = True
+        if cleared.any() or newly.any() or self.confirm > 0:
+            self.version += 1
+            self._inflated = None
+
+    def forget_older_than(self, stamp: float) -> None:
+        """Make every cell last seen before ``stamp`` unknown (recovery's clearing)."""
+        old = self.seen < stamp
+        if (old & self.occupied).any():
+            self.version += 1
+            self._inflated = None
+        self.seen[old] = -math.inf
+        self.occupied[old] = False
+        self.hit_since[old] = math.inf
+
+    # -- reading -----------------------------------------------------------------------
+
+    def known(self) -> BoolGrid:
+        return np.asarray(self.seen >= self.now - self.decay)
+
+    def lethal(self) -> BoolGrid:
+        """Cells occupied when last seen, within the decay time, and for at least the
+        confirmation time."""
+        return np.asarray(self.occupied & self.known()
+                          & (self.hit_since <= self.now - self.confirm))
+
+    def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
+        lethal = self.lethal()
+        key = int(self.version)
+        # Decay changes the lethal set without an update: compare the set itself.
+        if self._inflated is not None and self._inflated[0] == key and np.array_equal(
+                self._inflated[1], lethal):
+            return self._inflated[1], self._inflated[2]
+        if lethal.any():
+            gap = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * self.resolution
+            blocked = np.asarray(gap <= self.inflation)
+        else:
+            gap = np.full(lethal.shape, math.inf)
+            blocked = np.zeros_like(lethal)
+        self._inflated = (key, lethal, blocked)
+        self._gap = gap
+        return lethal, blocked
+
+    def blocked(self) -> BoolGrid:
+        """Cells whose centre lies within the inflation distance of an occupied cell:
+        the robot's centre must not enter them."""
+        return self._refresh()[1]
+
+    def gap(self) -> npt.NDArray[np.float64]:
+        """(nx, ny) distance from each cell's centre to the nearest occupied one, m (inf
+        when none is known)."""
+        self._refresh()
+        assert self._gap is not None
+        return self._gap
+
+    def blocked_at(self, points: Vec) -> npt.NDArray[np.bool_]:
+        """Whether each point (n, 2) lies in a blocked cell (outside the grid: free)."""
+        cells = self.cell_of(points)
+        ok = self.inside(cells)
+        out = np.zeros(len(cells), dtype=bool)
+        grid = self.blocked()
+        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return out
+
+    def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
+        cells = self.cell_of(points)
+        ok = self.inside(cells)
+        out = np.zeros(len(cells), dtype=bool)
+        grid = self._refresh()[0]
+        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return out
+
+    def values(self) -> npt.NDArray[np.int8]:
+        """(nx, ny) int8: -1 unknown, 0 free, 100 occupied."""
+        out = np.full(self.shape, UNKNOWN, dtype=np.int8)
+        known = self.known()
+        out[known] = FREE
+        out[self.lethal()] = OCCUPIED
+        return out

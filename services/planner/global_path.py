@@ -1,0 +1,208 @@
+"""The global path: the shortest way to the goal on the inflated occupancy grid, made
+any-angle by line-of-sight shortcuts (pure, no I/O).
+
+A grid search (Dijkstra on the 8-connected free cells, ``field.grid_distances``) from
+the goal gives every cell's distance to go and the way there; the robot's cell is
+followed down that way, and then, in the manner of Theta*, each vertex is joined to the
+farthest later one it sees in a straight line through free cells, so the path bends only
+where an obstacle makes it. Unknown cells count as free. With nothing known the path is
+the straight line from the robot to the goal, exactly the paper's global path.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.services.planner.costmap import Costmap
+from zenav.services.planner.field import grid_distances
+
+Vec = npt.NDArray[np.float64]
+BoolGrid = npt.NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class GlobalPlan:
+    points: Vec  # (n, 2) vertices from the robot to the goal; empty when no way exists
+    length: float  # m along the vertices (inf when no way)
+    reason: str  # why this plan was made
+
+    @property
+    def found(self) -> bool:
+        return len(self.points) >= 2
+
+
+def _nearest_free(free: BoolGrid, cell: tuple[int, int], radius: int) -> tuple[int, int] | None:
+    """The free cell nearest ``cell`` within ``radius`` cells, or None."""
+    nx, ny = free.shape
+    i0, j0 = cell
+    lo_i, hi_i = max(0, i0 - radius), min(nx, i0 + radius + 1)
+    lo_j, hi_j = max(0, j0 - radius), min(ny, j0 + radius + 1)
+    window = free[lo_i:hi_i, lo_j:hi_j]
+    if not window.any():
+        return None
+    ii, jj = np.nonzero(window)
+    d = (ii + lo_i - i0) ** 2 + (jj + lo_j - j0) ** 2
+    k = int(np.argmin(d))
+    return int(ii[k] + lo_i), int(jj[k] + lo_j)
+
+
+def visible(free: BoolGrid, costmap: Costmap, a: Vec, b: Vec) -> bool:
+    """Whether the straight segment a-b passes through free cells only (sampled every
+    quarter cell; points outside the grid count as free)."""
+    length = float(np.hypot(*(b - a)))
+    count = max(2, math.ceil(length / (costmap.resolution / 4)) + 1)
+    t = np.linspace(0.0, 1.0, count)[:, None]
+    points = a[None, :] + t * (b - a)[None, :]
+    cells = costmap.cell_of(points)
+    ok = costmap.inside(cells)
+    return bool(free[cells[ok, 0], cells[ok, 1]].all())
+
+
+def _cost_along(cost: npt.NDArray[np.float64], costmap: Costmap, points: Vec) -> float:
+    """The highest comfort cost over a polyline's cells (sampled every quarter cell)."""
+    worst = 0.0
+    for a, b in itertools.pairwise(points):
+        count = max(2, math.ceil(float(np.hypot(*(b - a))) / (costmap.resolution / 4)) + 1)
+        t = np.linspace(0.0, 1.0, count)[:, None]
+        cells = costmap.cell_of(a[None, :] + t * (b - a)[None, :])
+        ok = costmap.inside(cells)
+        if ok.any():
+            worst = max(worst, float(cost[cells[ok, 0], cells[ok, 1]].max()))
+    return worst
+
+
+def shortcut(free: BoolGrid, costmap: Costmap, points: Vec,
+             cost: npt.NDArray[np.float64] | None = None) -> Vec:
+    """Line-of-sight shortcutting: from each kept vertex, the farthest later vertex it
+    sees in a straight line is the next one kept. With ``cost`` (the comfort cost of
+    each cell), a shortcut may not come nearer the obstacles than the grid path it
+    replaces did: it cuts corners of the way, not into the room kept round obstacles."""
+    if len(points) <= 2:
+        return points
+
+    def ok(i: int, j: int) -> bool:
+        if not visible(free, costmap, points[i], points[j]):
+            return False
+        if cost is None:
+            return True
+        return (_cost_along(cost, costmap, points[[i, j]])
+                <= _cost_along(cost, costmap, points[i:j + 1]) + 1e-9)
+
+    kept = [0]
+    i = 0
+    last = len(points) - 1
+    while i < last:
+        j = last
+        while j > i + 1 and not ok(i, j):
+            # Binary-search-like back-off keeps long open stretches cheap.
+            j = i + 1 + (j - i - 1) // 2 if j - i > 8 else j - 1
+        # Then move forward as far as still allowed (the back-off may have overshot).
+        while j < last and ok(i, j + 1):
+            j += 1
+        kept.append(j)
+        i = j
+    return points[kept]
+
+
+COMFORT = 0.5
+"""m beyond the inflation over which a cell costs more the nearer it is to an obstacle
+(like the decaying cost of Nav2's inflation layer): the path keeps to the middle of a
+passage where it can, instead of grazing the inflation's edge."""
+COMFORT_WEIGHT = 2.0
+"""Extra cost per metre in a cell right at the inflation's edge (falling to 0 at
+``COMFORT`` beyond it)."""
+
+
+def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> GlobalPlan:
+    """The any-angle shortest way from ``start`` to ``goal`` round the blocked cells.
+
+    A start or goal inside a blocked (inflated) cell but not on an occupied one is joined
+    to the nearest free cell within the inflation distance: the robot may stand closer
+    to an obstacle than the margin, and a goal may lie near a wall. A goal on an
+    occupied cell, or one cut off, has no way (``found`` is False)."""
+    costmap.grow_to(np.vstack([start, goal]), costmap.padding / 2)
+    free = ~costmap.blocked()
+    ny = free.shape[1]
+    si, sj = (int(v) for v in costmap.cell_of(start[None, :])[0])
+    gi, gj = (int(v) for v in costmap.cell_of(goal[None, :])[0])
+    s_cell, g_cell = (si, sj), (gi, gj)
+    if costmap.lethal_at(goal[None, :])[0]:
+        return GlobalPlan(np.empty((0, 2)), math.inf, "goal occupied")
+    reach = max(1, math.ceil(costmap.inflation / costmap.resolution) + 1)
+    g_free = g_cell if free[g_cell] else _nearest_free(free, g_cell, reach)
+    s_free = s_cell if free[s_cell] else _nearest_free(free, s_cell, 2 * reach)
+    if g_free is None or s_free is None:
+        return GlobalPlan(np.empty((0, 2)), math.inf, "no free cell at start or goal")
+    if free.all() or (visible(free, costmap, start, goal) and s_free == s_cell
+                      and g_free == g_cell):
+        length = float(np.hypot(*(goal - start)))
+        return GlobalPlan(np.vstack([start, goal]), length, reason)
+    room = costmap.gap() - costmap.inflation
+    cost = COMFORT_WEIGHT * np.clip((COMFORT - room) / COMFORT, 0.0, 1.0)
+    dist, pred = grid_distances(free, g_free, costmap.resolution, cost)
+    if not math.isfinite(dist[s_free]):
+        return GlobalPlan(np.empty((0, 2)), math.inf, "no way to the goal")
+    cells = [s_free]
+    node = s_free[0] * ny + s_free[1]
+    target = g_free[0] * ny + g_free[1]
+    while node != target:
+        node = int(pred[node // ny, node % ny])
+        if node < 0:  # cannot happen for a finite distance; never loop on bad input
+            return GlobalPlan(np.empty((0, 2)), math.inf, "no way to the goal")
+        cells.append((node // ny, node % ny))
+    centres = costmap.centre_of(np.array(cells, dtype=np.int64))
+    points = np.vstack([start, centres[1:-1] if len(centres) > 2 else np.empty((0, 2)), goal])
+    points = shortcut(free, costmap, points, cost)
+    length = float(np.hypot(*np.diff(points, axis=0).T).sum())
+    return GlobalPlan(points, length, reason)
+
+
+# -- following a path -------------------------------------------------------------------
+
+
+def arc_lengths(points: Vec) -> Vec:
+    """Cumulative length at each vertex, from 0."""
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+
+
+def project(points: Vec, p: Vec) -> tuple[float, float]:
+    """(s, d): arc length of the point of the path nearest ``p``, and the distance."""
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    l2 = np.maximum((ab * ab).sum(axis=1), 1e-18)
+    t = np.clip(((p[None, :] - a) * ab).sum(axis=1) / l2, 0.0, 1.0)
+    near = a + t[:, None] * ab
+    d = np.hypot(*(near - p[None, :]).T)
+    k = int(np.argmin(d))
+    s = arc_lengths(points)
+    return float(s[k] + t[k] * math.sqrt(l2[k])), float(d[k])
+
+
+def point_at(points: Vec, s: float) -> Vec:
+    """The point of the path at arc length ``s`` (clamped to its ends)."""
+    lengths = arc_lengths(points)
+    s = min(max(s, 0.0), float(lengths[-1]))
+    k = int(np.searchsorted(lengths, s, side="right") - 1)
+    k = min(k, len(points) - 2)
+    seg = float(lengths[k + 1] - lengths[k])
+    t = 0.0 if seg < 1e-12 else (s - float(lengths[k])) / seg
+    return np.asarray(points[k] + t * (points[k + 1] - points[k]), dtype=np.float64)
+
+
+def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float) -> float | None:
+    """Arc length of the first point of the path, at or beyond ``from_s``, that lies in
+    a blocked cell; None if the rest of the path is free."""
+    total = float(arc_lengths(points)[-1])
+    if from_s >= total:
+        return None
+    s = np.arange(from_s, total + step / 2, step)
+    lengths = arc_lengths(points)
+    samples = np.column_stack([np.interp(s, lengths, points[:, 0]),
+                               np.interp(s, lengths, points[:, 1])])
+    hit = costmap.blocked_at(samples)
+    return float(s[int(np.argmax(hit))]) if hit.any() else None

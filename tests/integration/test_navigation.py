@@ -1,0 +1,71 @@
+"""The navigation classes beyond the paper's eight cases, through `zenav run`: each
+scenario in sim/scenarios/nav-*.yaml is reached with no contact, judged on the scenario's
+own geometry from run.json alone; the run record carries the planner's last global path."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from zenav.sim.contact import clearance
+from zenav.sim.scenario import load_scenario
+from zenav.sim.world import World
+
+pytestmark = pytest.mark.integration
+
+SCENARIOS = sorted((Path(__file__).resolve().parents[2] / "sim" / "scenarios")
+                   .glob("nav-*.yaml"))
+
+
+def zenav_run(scenario: Path, out: Path) -> dict[str, Any]:
+    done = subprocess.run([sys.executable, "-m", "zenav", "run", str(scenario), "--out", str(out),
+                           "--log-level", "WARNING"],
+                          capture_output=True, text=True, timeout=900, check=False)
+    assert done.returncode == 0, done.stderr
+    record: dict[str, Any] = json.loads((out / "run.json").read_text())
+    return record
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict[str, Any]]:
+    base = tmp_path_factory.mktemp("navigation")
+    with ThreadPoolExecutor(2) as pool:
+        return dict(pool.map(lambda p: (p.stem, zenav_run(p, base / p.stem)), SCENARIOS))
+
+
+def ground_truth_clearance(path: Path, trajectory: list[list[float]]) -> float:
+    scenario = load_scenario(path)
+    world = World.from_scenario(scenario)
+    return min((clearance((row[1], row[2]), scenario.robot.radius, world.snapshot(row[0]))
+                for row in trajectory), default=math.inf)
+
+
+def test_there_is_a_scenario_for_every_class():
+    names = {p.stem for p in SCENARIOS}
+    for needed in ("appear", "wall-gap", "dead-end", "corridor-follower", "corridor-head-on",
+                   "posts", "mover-stops", "facing-away"):
+        assert any(needed in name for name in names), needed
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=[p.stem for p in SCENARIOS])
+def test_class_scenario_is_reached_without_contact(path, records):
+    record = records[path.stem]
+    scenario = load_scenario(path)
+    assert record["outcome"] == "reached", f"{path.stem}: {record['outcome']} at {record['time']}"
+    last = record["trajectory"][-1]
+    assert math.dist(last[1:3], scenario.robot.goal) <= scenario.robot.goal_tolerance + 1e-6
+    assert ground_truth_clearance(path, record["trajectory"]) > 0.0
+    assert record["path"][-1] == pytest.approx(list(scenario.robot.goal))
+
+
+def test_the_appearing_box_is_never_taken_for_a_mover(records):
+    events = records["nav-appear-ahead"]["events"]
+    assert all(e["kind"] != "dynamic" for e in events), events
+    assert any(e["scenario"] == "b" and e["action"] == "morphin" for e in events)

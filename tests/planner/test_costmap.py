@@ -1,0 +1,74 @@
+"""The occupancy map: ray-traced free space, marked returns, movers left out, decay,
+confirmation, inflation and growth (pure, hand-made scans)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tests.planner.scans import scan_of
+from zenav.services.planner.costmap import FREE, OCCUPIED, UNKNOWN, Costmap
+
+
+def fresh(confirm: float = 0.0, decay: float = 60.0) -> Costmap:
+    return Costmap((0.0, 0.0), (6.0, 0.0), resolution=0.1, decay=decay, inflation=0.35,
+                   confirm=confirm, padding=2.0, max_size=100.0)
+
+
+def value_at(cm: Costmap, x: float, y: float) -> int:
+    i, j = cm.cell_of(np.array([[x, y]]))[0]
+    return int(cm.values()[i, j])
+
+
+def test_a_wall_ahead_is_occupied_the_way_to_it_free_and_behind_it_unknown() -> None:
+    cm = fresh()
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=[(3.0, -1.0, 3.2, 1.0)]), 0.0)
+    assert value_at(cm, 1.5, 0.0) == FREE
+    assert value_at(cm, 2.7, 0.5) == FREE
+    assert value_at(cm, 3.05, 0.0) == OCCUPIED
+    assert value_at(cm, 4.0, 0.0) == UNKNOWN  # behind the wall: never seen
+    assert value_at(cm, -1.0, 0.0) == UNKNOWN  # behind the robot: the laser sees 180 deg
+    # Inflated by the inflation distance, not more: the robot's centre keeps 0.35 m off.
+    assert cm.blocked_at(np.array([[2.75, 0.0]]))[0]
+    assert not cm.blocked_at(np.array([[2.55, 0.0]]))[0]
+
+
+def test_returns_on_a_mover_are_not_marked() -> None:
+    cm = fresh()
+    cm.update(scan_of((0.0, 0.0, 0.0), discs=[(2.0, 0.0, 0.3)]), 0.0,
+              movers=[(2.0, 0.0, 0.3)])
+    assert not cm.lethal().any()
+    cm.update(scan_of((0.0, 0.0, 0.0), discs=[(2.0, 0.0, 0.3)]), 0.1)
+    assert cm.lethal().any()  # the same returns, not on a known mover: marked
+
+
+def test_a_return_counts_once_confirmed_and_a_cell_left_unseen_decays_to_unknown() -> None:
+    cm = fresh(confirm=1.0, decay=5.0)
+    box = [(2.0, -0.5, 2.5, 0.5)]
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=box), 0.0)
+    assert not cm.lethal().any()
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=box), 1.0)
+    assert cm.lethal().any()
+    # Turned away: nothing refreshes those cells; after the decay time they are unknown.
+    cm.update(scan_of((0.0, 0.0, math.pi)), 3.0)
+    assert cm.lethal().any()
+    cm.update(scan_of((0.0, 0.0, math.pi)), 7.0)
+    assert not cm.lethal().any()
+    assert value_at(cm, 2.0, 0.0) == UNKNOWN
+
+
+def test_a_moving_front_beyond_any_track_leaves_no_confirmed_wake() -> None:
+    cm = fresh(confirm=1.0)
+    for k in range(30):  # a disc crossing at 0.5 m/s, 5 m ahead, never typed
+        t = k * 0.1
+        cm.update(scan_of((0.0, 0.0, 0.0), discs=[(5.0, -1.5 + 0.5 * t, 0.25)]), t)
+    assert not cm.lethal().any()
+
+
+def test_the_grid_grows_to_hold_what_is_seen_and_where_the_robot_goes() -> None:
+    cm = fresh()
+    before = cm.shape
+    cm.update(scan_of((0.0, 0.0, math.pi / 2), boxes=[(-0.5, 6.0, 0.5, 6.2)]), 0.0)
+    assert cm.shape[1] > before[1]
+    assert value_at(cm, 0.0, 6.05) == OCCUPIED

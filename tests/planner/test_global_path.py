@@ -1,0 +1,90 @@
+"""The global path on the map: the straight line when nothing is known, through the gap
+of a wall, round a dead-end cup, and no way to a goal that is walled in. Randomised
+layouts (gap positions, cup sizes) check that nothing is tuned to one scene."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from tests.planner.scans import cup, scan_of, wall_with_gap
+from zenav.services.planner.costmap import Costmap
+from zenav.services.planner.global_path import plan_path, visible
+
+START = np.array([0.0, 4.0])
+GOAL = np.array([8.0, 4.0])
+
+
+def mapped(boxes, poses=((0.0, 4.0, 0.0),), stamps=(0.0, 1.5)) -> Costmap:
+    cm = Costmap((0.0, 4.0), (8.0, 4.0), resolution=0.1, decay=60.0, inflation=0.35,
+                 confirm=1.0, padding=3.0, max_size=100.0)
+    for t in stamps:
+        for pose in poses:
+            cm.update(scan_of(pose, boxes=boxes), t)
+    return cm
+
+
+def clear_of_blocked(cm: Costmap, points: np.ndarray) -> bool:
+    free = ~cm.blocked()
+    return all(visible(free, cm, a, b) for a, b in itertools.pairwise(points))
+
+
+def test_with_nothing_known_the_path_is_the_straight_start_goal_line() -> None:
+    cm = mapped([], stamps=())
+    plan = plan_path(cm, START, GOAL)
+    assert plan.found
+    np.testing.assert_array_equal(plan.points, np.vstack([START, GOAL]))
+    assert plan.length == pytest.approx(8.0)
+
+
+def test_a_clear_view_keeps_the_straight_line() -> None:
+    plan = plan_path(mapped([(3.0, 6.0, 4.0, 7.0)]), START, GOAL)
+    assert len(plan.points) == 2
+
+
+def test_the_path_goes_through_the_gap_of_a_wall_across_the_way() -> None:
+    cm = mapped(wall_with_gap(4.0, 5.3, 6.3))
+    plan = plan_path(cm, START, GOAL)
+    assert plan.found
+    crossing = [p for a, b in zip(plan.points[:-1], plan.points[1:], strict=True)
+                for p in [a + (b - a) * ((4.0 - a[0]) / (b[0] - a[0]))]
+                if (a[0] - 4.0) * (b[0] - 4.0) < 0]
+    assert len(crossing) == 1 and 5.3 + 0.35 <= crossing[0][1] <= 6.3 - 0.35
+    assert clear_of_blocked(cm, plan.points)
+    assert len(plan.points) <= 5  # any-angle: a few vertices, not a staircase of cells
+
+
+def test_the_path_goes_round_a_dead_end_cup_not_into_it() -> None:
+    cm = mapped(cup(4.5, 4.0, width=2.0, depth=1.5))
+    plan = plan_path(cm, START, GOAL)
+    assert plan.found and clear_of_blocked(cm, plan.points)
+    assert max(abs(p[1] - 4.0) for p in plan.points) > 1.0  # round the outside
+
+
+def test_a_goal_on_an_obstacle_or_walled_in_has_no_way() -> None:
+    near = (3.0, 4.0, 0.0)  # within the laser's 8 m of the goal
+    on_goal = mapped([(8.02, 3.5, 8.5, 4.5)], poses=(near,))  # its face crosses the goal cell
+    assert not plan_path(on_goal, np.array(near[:2]), GOAL).found
+    ring = [(6.5, 2.5, 9.5, 2.7), (6.5, 5.3, 9.5, 5.5), (6.5, 2.5, 6.7, 5.5),
+            (9.3, 2.5, 9.5, 5.5)]
+    walled = mapped(ring, poses=((0.0, 4.0, 0.0), (8.0, 4.0, 0.0), (8.0, 4.0, math.pi)))
+    assert not plan_path(walled, START, GOAL).found
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_gaps_and_cups_are_found_whatever_their_place(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    gap_low = float(rng.uniform(1.0, 6.5))
+    width = float(rng.uniform(0.9, 1.4))
+    x = float(rng.uniform(3.0, 5.0))
+    cm = mapped(wall_with_gap(x, gap_low, gap_low + width))
+    plan = plan_path(cm, START, GOAL)
+    assert plan.found and clear_of_blocked(cm, plan.points), (gap_low, width, x)
+    size = float(rng.uniform(1.2, 2.6))
+    cm = mapped(cup(float(rng.uniform(4.0, 6.0)), 4.0 + float(rng.uniform(-0.3, 0.3)),
+                    width=size, depth=float(rng.uniform(0.8, 2.0))))
+    plan = plan_path(cm, START, GOAL)
+    assert plan.found and clear_of_blocked(cm, plan.points), size

@@ -1,0 +1,223 @@
+"""The planner's stages on hand-made geometry: one test per paper scenario letter, one
+per recovery step, the stop-zone stage and the map/global-path stages inside a cycle.
+
+The robot starts at (2, 3) heading +x for a goal at (8, 3), at the paper's 0.1 m/s."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.planner.scans import scan_of
+from zenav.services.motor_bridge.command_filter import CommandFilter
+from zenav.services.motor_bridge.params import Params as BridgeParams
+from zenav.services.planner.decide import Decision, Planner
+from zenav.services.planner.params import Params
+from zenav.services.planner.prediction import Obstacle
+
+POSE = (2.0, 3.0, 0.0)
+
+
+def planner(**changes: object) -> Planner:
+    return Planner(Params.model_validate({"goal": (8.0, 3.0), "start": (2.0, 3.0),
+                                          **changes}))
+
+
+def cells(x: float, y: float, half: float = 0.0, cell: float = 0.5) -> tuple[int, int, int, int]:
+    lo = [math.floor((v - half) / cell + 0.5) for v in (x, y)]
+    hi = [math.floor((v + half) / cell + 0.5) for v in (x, y)]
+    return (lo[0], hi[0], lo[1], hi[1])
+
+
+def mover(id_: int, x: float, y: float, vx: float, vy: float, r: float = 0.2) -> Obstacle:
+    return Obstacle(id_, "dynamic", (x, y), (vx, vy), r, cells(x, y))
+
+
+def box(id_: int, x: float, y: float) -> Obstacle:
+    return Obstacle(id_, "static", (x, y), (0.0, 0.0), 0.35, cells(x, y, 0.2))
+
+
+def decide(p: Planner, obstacles: list[Obstacle], stamps=(0.0, 2.5)) -> Decision:
+    """The decision once the obstacles have been seen for ``stamps[-1]`` s (a standing
+    obstacle is answered once confirmed)."""
+    d = None
+    for t in stamps:
+        d = p.step(POSE, obstacles, t)
+    assert d is not None
+    return d
+
+
+def letters(d: Decision) -> set[str]:
+    return {n.letter for n in d.notes}
+
+
+# -- the paper's eight scenarios --------------------------------------------------------
+
+
+def test_a_nothing_in_the_way_keeps_speed_and_heading() -> None:
+    d = decide(planner(), [])
+    assert (d.scenario, d.action) == ("a", "keep")
+    assert d.v == pytest.approx(0.1) and d.omega == pytest.approx(0.0)
+
+
+def test_b_a_standing_box_on_the_path_is_gone_round_with_morphin() -> None:
+    d = decide(planner(), [box(1, 4.0, 3.0)])
+    assert (d.scenario, d.action) == ("b", "morphin")
+    assert abs(d.target[1] - 3.0) > 0.3  # a sub-target off the line
+
+
+def test_c_a_crosser_that_passes_first_is_let_be() -> None:
+    d = decide(planner(), [mover(1, 4.0, 2.0, 0.0, 0.5)], stamps=(0.0,))
+    assert "c" in letters(d)
+    assert (d.scenario, d.action) == ("a", "keep")
+
+
+def test_d_a_crosser_that_comes_after_is_let_be() -> None:
+    d = decide(planner(), [mover(1, 4.0, 0.0, 0.0, 0.05)], stamps=(0.0,))
+    assert "d" in letters(d)
+    assert (d.scenario, d.action) == ("a", "keep")
+
+
+def test_e_a_crosser_that_would_meet_the_robot_changes_its_speed() -> None:
+    d = decide(planner(), [mover(1, 3.0, 2.0, 0.0, 0.1)], stamps=(0.0,))
+    assert d.scenario == "e" and d.action in {"stop", "slow", "speed_up"}
+    assert d.speed != pytest.approx(0.1)
+
+
+def test_f_a_mover_coming_head_on_is_gone_round_with_morphin() -> None:
+    d = decide(planner(), [mover(1, 5.0, 3.0, -0.2, 0.0)], stamps=(0.0,))
+    assert (d.scenario, d.action) == ("f", "morphin")
+    assert abs(d.target[1] - 3.0) > 0.2
+
+
+def test_g_a_slower_mover_ahead_the_same_way_is_followed_slower() -> None:
+    d = decide(planner(), [mover(1, 3.0, 3.0, 0.05, 0.0)], stamps=(0.0,))
+    assert d.scenario == "g" and d.action in {"slow", "stop"}
+    assert d.speed < 0.1
+
+
+def test_h_a_box_and_a_crosser_at_once_are_answered_together() -> None:
+    d = decide(planner(), [box(1, 4.5, 3.0), mover(2, 3.0, 2.0, 0.0, 0.1)],
+               stamps=(0.0, 2.0))
+    assert d.scenario == "h"
+
+
+# -- the map and the global path inside a cycle -------------------------------------------
+
+
+def test_a_wall_seen_in_the_scans_bends_the_global_path_through_its_gap() -> None:
+    p = planner(window_radius=2.0)
+    wall = [(6.0, -1.0, 6.2, 4.5), (6.0, 5.5, 6.2, 9.0)]  # gap 4.5..5.5, beyond the window
+    for k in range(20):
+        p.step(POSE, [], k * 0.1, scan_of(POSE, boxes=wall))
+    assert p.path is not None and len(p.path) > 2
+    at_wall = p.path[np.argmin(np.abs(p.path[:, 0] - 6.1))]
+    assert 4.5 < at_wall[1] < 5.5
+    assert p.plan is not None and p.plan.reason == "blocked beyond the window"
+
+
+def test_with_no_scan_the_global_path_is_the_straight_line() -> None:
+    p = planner()
+    p.step(POSE, [], 0.0)
+    assert p.path is not None
+    np.testing.assert_array_equal(p.path, [[2.0, 3.0], [8.0, 3.0]])
+
+
+# -- the stop zone ------------------------------------------------------------------------
+
+
+def test_forward_motion_into_the_stop_zone_becomes_a_turn_toward_the_free_side() -> None:
+    p = planner()
+    blocker = [(2.3, 2.9, 2.5, 3.5)]  # just ahead, more of it on the left
+    scan = scan_of(POSE, boxes=blocker)
+    d = p.step(POSE, [], 0.0, scan)
+    assert d.refused and d.v == 0.0
+    assert d.omega < 0.0  # toward the right, the free side
+    # The same pure check as the motor bridge's, with the same geometry.
+    bridge = CommandFilter(BridgeParams())
+    assert bridge.params.zone_margin == p.p.zone_margin
+    assert p.p.blocks(scan.ranges.astype(np.float32), scan.angle_min, scan.angle_increment,
+                      scan.range_max, 0.1, p.p.robot_radius)
+
+
+# -- recovery steps -----------------------------------------------------------------------
+
+
+def stall(p: Planner, t: float, pose: tuple[float, float, float], until: str,
+          limit: float = 60.0) -> tuple[float, Decision]:
+    """Keep the robot where it is until the planner's action is ``until``."""
+    end = t + limit
+    while t < end:
+        d = p.step(pose, [], t)
+        if d.action == until:
+            return t, d
+        t = round(t + 0.1, 6)
+    raise AssertionError(f"no {until!r} within {limit} s")
+
+
+def test_recovery_replans_then_spins_a_full_turn() -> None:
+    p = planner(progress_timeout=2.0)
+    t, d = stall(p, 0.0, POSE, "replan")
+    assert t == pytest.approx(2.0, abs=0.15) and d.v == 0.0
+    t, d = stall(p, t, POSE, "spin")
+    assert d.v == 0.0 and d.omega > 0.0
+    heading, turned = 0.0, 0.0
+    while d.action == "spin":
+        heading += d.omega * 0.1
+        turned += d.omega * 0.1
+        t = round(t + 0.1, 6)
+        d = p.step((2.0, 3.0, heading), [], t)
+    assert turned == pytest.approx(2 * math.pi, abs=0.15)
+
+
+def test_recovery_backs_up_only_along_the_way_just_driven() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=10.0)
+    t = 0.0
+    for k in range(11):  # drive 0.5 m first: that way is known free
+        p.step((1.5 + 0.05 * k, 3.0, 0.0), [], t)
+        t = round(t + 0.1, 6)
+    here = (2.0, 3.0, 0.0)
+    t, d = stall(p, t, here, "back_up")
+    assert d.v == pytest.approx(-p.p.backup_speed) and d.omega == 0.0
+    x, moved = 2.0, 0.0
+    while d.action == "back_up":
+        x += d.v * 0.1
+        moved -= d.v * 0.1
+        t = round(t + 0.1, 6)
+        d = p.step((x, 3.0, 0.0), [], t)
+    assert moved == pytest.approx(p.p.backup_distance, abs=0.06)
+
+
+def test_with_nothing_driven_behind_there_is_no_back_up_then_a_wait_stands_still() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=3.0)
+    t, d = stall(p, 0.0, POSE, "wait")
+    assert d.v == 0.0 and d.omega == 0.0
+    start = t
+    while d.action == "wait":
+        t = round(t + 0.1, 6)
+        d = p.step(POSE, [], t)
+    assert t - start == pytest.approx(3.0, abs=0.15)
+
+
+def test_a_goal_inside_an_obstacle_ends_in_unreachable_and_the_robot_stops() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    wall = [(8.02, 1.0, 8.5, 5.0)]  # its face runs through the goal's cell: no way there
+    t = 0.0
+    d = None
+    while t < 120.0:
+        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
+        if d.action == "unreachable":
+            break
+        t = round(t + 0.1, 6)
+    assert d is not None and d.action == "unreachable", d
+    assert p.plan is not None and p.plan.reason == "goal occupied"
+    assert d.v == 0.0 and d.omega == 0.0
+    assert p.step(POSE, [], t + 1.0).action == "unreachable"  # for good
+
+
+def test_while_a_way_is_known_recovery_goes_on_and_never_gives_up() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    actions = {p.step(POSE, [], round(k * 0.1, 6)).action for k in range(600)}
+    assert {"replan", "spin", "wait"} <= actions and "unreachable" not in actions

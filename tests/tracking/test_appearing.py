@@ -1,0 +1,69 @@
+"""An obstacle that appears out of nothing is new, then typed from its own next scans:
+not dynamic because the scans before it saw its place empty."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from zenav.schemas.messages import LaserScan
+from zenav.services.perception.params import PerceptionParams
+from zenav.services.perception.perceive import Perceiver
+from zenav.services.tracking.params import TrackingParams
+from zenav.services.tracking.tracker import Track, Tracker
+from zenav.sim.raycast import simulate_scan
+from zenav.sim.world import WorldSnapshot
+
+ANGLES = -math.pi / 2 + math.radians(0.5) * np.arange(361)
+DT = 0.1
+
+
+def kinds(box_at: float, velocity: tuple[float, float], seconds: float,
+          robot_speed: float = 0.1) -> list[tuple[float, Track | None]]:
+    """The robot drives along +x at ``robot_speed``; a 0.5 m box appears at
+    ``box_at`` s, 1 m ahead of the robot, and moves at ``velocity``. (t, the track
+    nearest the box) per scan through perception (with its motion cue) and tracking."""
+    perceiver = Perceiver(PerceptionParams())
+    tracker = Tracker(TrackingParams())
+    rng = np.random.default_rng(3)
+    out: list[tuple[float, Track | None]] = []
+    for i in range(round(seconds / DT)):
+        t = i * DT
+        pose = (robot_speed * t, 0.0, 0.0)
+        boxes = []
+        centre = None
+        if t >= box_at:
+            cx = robot_speed * box_at + 1.0 + 0.25 + velocity[0] * (t - box_at)
+            cy = velocity[1] * (t - box_at)
+            centre = (cx, cy)
+            boxes.append((cx - 0.25, cy - 0.25, cx + 0.25, cy + 0.25))
+        ranges = simulate_scan(pose[:2], pose[2], ANGLES, WorldSnapshot.build(boxes=boxes),
+                               8.0, 0.01, rng)
+        scan = LaserScan(stamp=t, seq=i, frame="laser", angle_min=-math.pi / 2,
+                         angle_max=math.pi / 2, angle_increment=math.radians(0.5),
+                         range_min=0.0, range_max=8.0, ranges=ranges)
+        tracks = tracker.update(t, pose, perceiver.process(scan, pose))
+        near = None
+        if centre is not None and tracks:
+            near = min(tracks, key=lambda tr: math.hypot(tr.x - centre[0], tr.y - centre[1]))
+        out.append((t, near))
+    return out
+
+
+def test_a_box_that_appears_ahead_is_new_then_static_never_dynamic() -> None:
+    frames = kinds(box_at=2.0, velocity=(0.0, 0.0), seconds=6.0)
+    seen = [(t, tr) for t, tr in frames if tr is not None]
+    assert seen, "the box was never tracked"
+    assert seen[0][1].kind == "new"  # the paper's type for a first sighting
+    assert all(tr.kind != "dynamic" for _, tr in seen), [(t, tr.kind) for t, tr in seen]
+    assert seen[-1][1].kind == "static"
+
+
+@pytest.mark.parametrize("speed", [0.15, 0.4])
+def test_a_mover_that_appears_ahead_is_still_typed_dynamic(speed: float) -> None:
+    # Crossing the robot's way: judged from its own next scans, it is seen to move.
+    frames = kinds(box_at=2.0, velocity=(0.0, speed), seconds=6.0)
+    late = [tr for t, tr in frames if tr is not None and t >= 4.5]
+    assert late and all(tr.kind == "dynamic" for tr in late), [tr.kind for tr in late]
