@@ -9,6 +9,7 @@ the reason.
 
 from __future__ import annotations
 
+import math
 from typing import Any, TypeVar
 
 import msgpack
@@ -79,6 +80,23 @@ def decode(
         raise DecodeError(key, "invalid", _summarise(exc)) from None
     except Exception as exc:  # a validator failing in a way pydantic does not wrap
         raise DecodeError(key, "invalid", f"{type(exc).__name__}: {exc}"[:300]) from None
+
+
+def peek_stamp(payload: bytes) -> tuple[float | None, int | None]:
+    """The envelope's ``stamp`` (s) and ``seq`` without validating the rest: for tools that
+    file messages by time (recorders), never for acting on a message. None where a field
+    is missing, malformed, or the payload is not one of zenav's messages."""
+    try:
+        fields = msgpack.unpackb(payload, raw=False, strict_map_key=True)
+    except Exception:  # any unpacking failure means "no stamp", by contract
+        return None, None
+    if not isinstance(fields, dict):
+        return None, None
+    stamp, seq = fields.get("stamp"), fields.get("seq")
+    good_stamp = (isinstance(stamp, (int, float)) and not isinstance(stamp, bool)
+                  and math.isfinite(stamp) and stamp >= 0)
+    good_seq = isinstance(seq, int) and not isinstance(seq, bool) and seq >= 0
+    return (float(stamp) if good_stamp else None), (seq if good_seq else None)
 
 
 def _summarise(exc: ValidationError) -> str:

@@ -147,3 +147,15 @@ def test_commands_reject_non_finite_speeds():
         VelocityCommand(stamp=0.0, seq=0, v=math.nan, omega=0.0)
     with pytest.raises(ValueError):
         BaseCommand(stamp=0.0, seq=0, v=0.0, omega=math.inf)
+
+
+def test_peek_stamp_reads_the_envelope_and_refuses_nothing() -> None:
+    from zenav.schemas.codec import peek_stamp
+    from zenav.schemas.messages import VelocityCommand
+
+    payload = encode(VelocityCommand(stamp=12.5, seq=7, v=0.1, omega=0.0))
+    assert peek_stamp(payload) == (12.5, 7)
+    assert peek_stamp(b"\xc1 not msgpack") == (None, None)
+    assert peek_stamp(msgpack.packb([1, 2])) == (None, None)
+    assert peek_stamp(msgpack.packb({"stamp": -1.0, "seq": True})) == (None, None)
+    assert peek_stamp(msgpack.packb({"stamp": float("nan"), "seq": 3})) == (None, 3)

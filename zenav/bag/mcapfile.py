@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-import msgpack
 from mcap.decoder import DecoderFactory
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
@@ -20,7 +19,7 @@ from mcap.writer import Writer
 
 import zenav
 from zenav.schemas import keys
-from zenav.schemas.codec import SCHEMA_VERSION, decode
+from zenav.schemas.codec import SCHEMA_VERSION, decode, peek_stamp
 from zenav.schemas.keys import ROOT, Keys
 from zenav.schemas.messages import ALL_MESSAGES, Message
 
@@ -49,14 +48,10 @@ def json_schema(message: type[Message]) -> bytes:
 
 
 def _stamp_and_seq(payload: bytes) -> tuple[int | None, int]:
-    """The message's stamp (ns) and seq, without validating the rest."""
-    try:
-        fields = msgpack.unpackb(payload, raw=False)
-        stamp, seq = fields.get("stamp"), fields.get("seq", 0)
-        stamp_ns = round(float(stamp) * 1e9) if stamp is not None and stamp >= 0 else None
-        return stamp_ns, int(seq) % 2**32 if isinstance(seq, int) and seq >= 0 else 0
-    except Exception:
-        return None, 0
+    """The message's stamp (ns) and seq for the MCAP index, without validating the rest."""
+    stamp, seq = peek_stamp(payload)
+    stamp_ns = None if stamp is None else round(stamp * 1e9)
+    return stamp_ns, 0 if seq is None else seq % 2**32
 
 
 class BagWriter:
