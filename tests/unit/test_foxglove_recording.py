@@ -22,6 +22,7 @@ from zenav.schemas.messages import (
     Obstacle,
     ObstacleChain,
     ObstacleTruth,
+    OccupancyMap,
     PlannerEvent,
     Pose2D,
 )
@@ -78,13 +79,21 @@ def record(messages: list[tuple[str, Any]]) -> tuple[dict[str, list[Any]], dict[
     return out, schemas
 
 
+def occupancy(stamp: float) -> OccupancyMap:
+    cells = np.zeros((2, 3), dtype=np.int8)  # (iy, ix)
+    cells[0, 2], cells[1, 0] = 100, -1
+    return OccupancyMap(stamp=stamp, seq=0, origin=(-1.0, -0.5), resolution=0.25, width=3,
+                        height=2, cells=cells.ravel())
+
+
 @pytest.fixture
 def decoded():
     t = 12.5
     return record([("odom", samples.odometry(t)), ("scan", samples.scan(t)),
                    ("obstacles", obstacle_chain(t)), ("tracks", samples.tracks(t)),
                    ("planner/state", samples.state(t)), ("planner/path", path(t)),
-                   ("sim/truth", truth(t)), ("planner/events", event(t))])
+                   ("planner/map", occupancy(t)), ("sim/truth", truth(t)),
+                   ("planner/events", event(t))])
 
 
 def test_every_foxglove_topic_is_written_with_its_schema(decoded):
@@ -149,6 +158,19 @@ def test_a_path_before_any_state_and_an_empty_path():
     assert [e.id for e in second.entities] == ["path"]
     assert len(second.entities[0].lines) == 0  # no way known: the old path is gone
     assert [e.id for e in third.entities] == ["plan", "path"]
+
+
+def test_the_map_is_a_grid(decoded):
+    out, _ = decoded
+    (grid,) = out["/foxglove/map"]
+    assert grid.frame_id == "odom" and grid.column_count == 3
+    assert (grid.pose.position.x, grid.pose.position.y) == (-1.0, -0.5)
+    assert (grid.cell_size.x, grid.cell_size.y) == (0.25, 0.25)
+    assert (grid.row_stride, grid.cell_stride) == (3, 1)
+    (field,) = grid.fields
+    assert (field.name, field.offset, field.type) == ("occupancy", 0, 2)  # INT8
+    cells = np.frombuffer(grid.data, dtype=np.int8).reshape(2, 3)
+    assert cells[0, 2] == 100 and cells[1, 0] == -1 and cells.sum() == 99
 
 
 def test_planner_events_are_log_lines(decoded):

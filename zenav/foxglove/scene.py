@@ -14,6 +14,8 @@ Topics (all under ``/foxglove/``), frames ``odom`` (the world: zenav's poses),
   its scenario letter and action, and its latest global path (``planner/path``) as a
   blue line from the robot to the goal (each update carries both, since it replaces the
   last one);
+- ``map``: ``foxglove.Grid``, the planner's occupancy map (``planner/map``): one INT8
+  field ``occupancy`` per cell, -1 unknown, 0 free, 100 occupied, as ROS draws it;
 - ``truth``: ``foxglove.SceneUpdate``, the simulator's ground truth (green, translucent);
 - ``log``: ``foxglove.Log``, one line per planner event.
 """
@@ -32,6 +34,7 @@ from zenav.schemas.messages import (
     LaserScan,
     Message,
     ObstacleChain,
+    OccupancyMap,
     Odometry,
     PlannerEvent,
     PlannerState,
@@ -50,6 +53,7 @@ TOPICS: dict[str, type[Any]] = {
     "/foxglove/obstacles": fm.SceneUpdate,
     "/foxglove/tracks": fm.SceneUpdate,
     "/foxglove/plan": fm.SceneUpdate,
+    "/foxglove/map": fm.Grid,
     "/foxglove/truth": fm.SceneUpdate,
     "/foxglove/log": fm.Log,
 }
@@ -182,6 +186,18 @@ def _target_entity(state: PlannerState, odometry: Odometry | None) -> fm.SceneEn
     return _entity(state.stamp, "plan", lines=[line], texts=[text])
 
 
+def occupancy_grid(occupancy: OccupancyMap) -> fm.Grid:
+    """The map as a grid of one INT8 field, rows along y from the map's origin."""
+    ox, oy = occupancy.origin
+    r = occupancy.resolution
+    return fm.Grid(timestamp=timestamp(occupancy.stamp), frame_id=ODOM, pose=pose(ox, oy),
+                   column_count=occupancy.width, cell_size=fm.Vector2(x=r, y=r),
+                   row_stride=occupancy.width, cell_stride=1,
+                   fields=[fm.PackedElementField(
+                       name="occupancy", offset=0, type=fm.PackedElementFieldNumericType.Int8)],
+                   data=np.ascontiguousarray(occupancy.cells, dtype=np.int8).tobytes())
+
+
 def truth(ground: GroundTruth) -> fm.SceneUpdate:
     green = (0.2, 0.9, 0.3, 0.35)
     cylinders, cubes = [], []
@@ -239,6 +255,8 @@ class SceneBuilder:
         if isinstance(message, GlobalPath):
             self.path = message
             return [("/foxglove/plan", plan(self.state, self.odometry, message))]
+        if isinstance(message, OccupancyMap):
+            return [("/foxglove/map", occupancy_grid(message))]
         if isinstance(message, GroundTruth):
             return [("/foxglove/truth", truth(message))]
         if isinstance(message, PlannerEvent):
