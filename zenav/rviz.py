@@ -3,9 +3,9 @@
 Read-only, from any host: it follows zenav's tracks and planner state and publishes
 ``visualization_msgs/msg/MarkerArray`` on ``/zenav/markers`` (a cylinder per tracked
 obstacle coloured by type, a velocity arrow per mover, the planner's scenario letter and
-action as text above the robot), in the odometry frame. In RViz: Add > By topic >
-/zenav/markers. The global path (``nav_msgs/msg/Path``) follows once the planner
-publishes one (:func:`zenav.services.ros2.view.path_to_ros` builds it).
+action as text above the robot), in the odometry frame, and the planner's global path
+(``planner/path``) as ``nav_msgs/msg/Path`` on ``/zenav/plan`` whenever it is planned
+again. In RViz: Add > By topic > /zenav/markers and /zenav/plan.
 """
 
 from __future__ import annotations
@@ -19,33 +19,46 @@ from typing import Any
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
-from zenav.schemas.messages import PlannerState, TrackList
+from zenav.schemas.messages import GlobalPath, PlannerState, TrackList
 from zenav.services.ros2.node import Ros2Node
-from zenav.services.ros2.view import tracks_to_markers
-from zenav.services.ros2.wire import MARKER_ARRAY, WireError, qualify
+from zenav.services.ros2.view import path_to_ros, tracks_to_markers
+from zenav.services.ros2.wire import MARKER_ARRAY, PATH, WireError, qualify
 from zenav.services.runner import add_transport_arguments
 from zenav.services.transport import Bus
 from zenav.tooling import ConnectError, add_connect_timeout, open_bus, stop_on_signals, tool_setup
 
 
 class RvizView:
-    """Tracks and planner state in, MarkerArray out (one per track list)."""
+    """Tracks and planner state in, MarkerArray out (one per track list); global paths
+    in, Path out (one per path)."""
 
     def __init__(self, bus: Bus, robot_id: str, *, domain_id: int = 0,
                  topic: str = "/zenav/markers", frame: str = "odom",
-                 node_name: str = "zenav_view") -> None:
+                 path_topic: str = "/zenav/plan", node_name: str = "zenav_view") -> None:
         self.keys = Keys(robot_id)
         self.frame = frame
         self.ros = Ros2Node(bus, node_name, domain_id)
         self.markers = self.ros.publisher(qualify(topic), MARKER_ARRAY)
+        self.path = self.ros.publisher(qualify(path_topic), PATH)
         self.tracks = bus.subscribe(self.keys.of(keys.TRACKS), depth=1)
         self.states = bus.subscribe(self.keys.of(keys.PLANNER_STATE), depth=1)
+        self.paths = bus.subscribe(self.keys.of(keys.PATH), depth=1)
         self.state: PlannerState | None = None
         self.sent = 0
+        self.paths_sent = 0
 
     def on_state(self, payload: bytes) -> None:
         with contextlib.suppress(DecodeError):
             self.state = decode(payload, PlannerState, self.keys.of(keys.PLANNER_STATE))
+
+    def on_path(self, payload: bytes) -> None:
+        try:
+            path = decode(payload, GlobalPath, self.keys.of(keys.PATH), keys.PATH.max_bytes)
+        except DecodeError:
+            return
+        points = [(float(x), float(y)) for x, y in path.points]
+        self.path.publish(path_to_ros(points, path.stamp, self.frame))
+        self.paths_sent += 1
 
     def on_tracks(self, payload: bytes) -> None:
         try:
@@ -61,16 +74,23 @@ class RvizView:
             while True:
                 self.on_state((await self.states.get())[1])
 
-        task = asyncio.get_running_loop().create_task(states())
+        async def paths() -> None:
+            while True:
+                self.on_path((await self.paths.get())[1])
+
+        loop = asyncio.get_running_loop()
+        tasks = [loop.create_task(states()), loop.create_task(paths())]
         try:
             while True:
                 self.on_tracks((await self.tracks.get())[1])
         finally:
-            task.cancel()
+            for task in tasks:
+                task.cancel()
 
     def close(self) -> None:
         self.tracks.close()
         self.states.close()
+        self.paths.close()
         self.ros.close()
 
 
@@ -80,7 +100,8 @@ async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None
     bus = await open_bus(transport, stop, args.connect_timeout, "zenav rviz")
     if bus is None:  # stopped while connecting
         return
-    view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame)
+    view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame,
+                    path_topic=args.path_topic)
     task = asyncio.get_running_loop().create_task(view.run())
     try:
         await stop.wait()
@@ -96,11 +117,12 @@ def main(args: argparse.Namespace) -> int:
     setup = tool_setup(args, "rviz")
     if setup is None:
         return 2
-    try:
-        qualify(args.topic)
-    except WireError as exc:
-        print(f"zenav rviz: --topic: {exc}", file=sys.stderr)
-        return 2
+    for option, topic in (("--topic", args.topic), ("--path-topic", args.path_topic)):
+        try:
+            qualify(topic)
+        except WireError as exc:
+            print(f"zenav rviz: {option}: {exc}", file=sys.stderr)
+            return 2
     robot_id, transport = setup
     try:
         with contextlib.suppress(KeyboardInterrupt):
@@ -113,11 +135,15 @@ def main(args: argparse.Namespace) -> int:
 
 def add_command(sub: Any) -> None:
     rviz = sub.add_parser(
-        "rviz", help="publish zenav's tracks and planner state for RViz over rmw_zenoh",
+        "rviz", help="publish zenav's tracks, planner state and global path for RViz over "
+        "rmw_zenoh",
         description="Tracked obstacles (type colour, velocity arrows) and the planner's "
-        "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic.")
+        "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic, and "
+        "the planner's global path as nav_msgs/msg/Path on another.")
     rviz.add_argument("--domain-id", type=int, default=0, help="ROS_DOMAIN_ID (default 0)")
     rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
+    rviz.add_argument("--path-topic", default="/zenav/plan",
+                      help="Path topic (default /zenav/plan)")
     rviz.add_argument("--frame", default="odom", help="frame of zenav's poses (default odom)")
     add_transport_arguments(rviz)
     add_connect_timeout(rviz)

@@ -4,12 +4,17 @@ with the planner's latest state as a text marker and the view's liveliness token
 from __future__ import annotations
 
 import asyncio
+import math
+
+import numpy as np
+import pytest
 
 from tests.ros2 import samples
 from zenav.rviz import RvizView
 from zenav.schemas import keys
 from zenav.schemas.codec import encode
 from zenav.schemas.keys import Keys
+from zenav.schemas.messages import GlobalPath
 from zenav.services.ros2 import wire
 from zenav.services.transport import InMemoryBus
 
@@ -36,4 +41,35 @@ async def test_tracks_become_markers_for_rviz():
     markers = wire.deserialize(sent[0], wire.MARKER_ARRAY).markers
     assert {m.ns for m in markers} == {"", "tracks", "velocity", "planner"}
     assert next(m for m in markers if m.ns == "planner").text.startswith("(c) slow")
-    assert {(t.kind, t.topic) for t in tokens} == {("NN", None), ("MP", "/zenav/markers")}
+    assert {(t.kind, t.topic) for t in tokens} == {("NN", None), ("MP", "/zenav/markers"),
+                                                 ("MP", "/zenav/plan")}
+
+
+async def test_global_path_becomes_a_ros_path():
+    bus = InMemoryBus()
+    view = RvizView(bus, "robot0", domain_id=3, frame="odom")
+    task = asyncio.create_task(view.run())
+    k = Keys("robot0")
+    try:
+        bus.deliver(k.of(keys.PATH), b"garbage")  # ignored, not fatal
+        await asyncio.sleep(0.01)
+        points = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]])
+        bus.deliver(k.of(keys.PATH), encode(GlobalPath(stamp=7.25, seq=0, points=points,
+                                                       reason="start")))
+        await asyncio.sleep(0.01)
+        key = wire.topic_key(3, "/zenav/plan", wire.PATH)
+        sent = [p for kk, p in bus.published if kk == key]
+        tokens = [wire.parse_token(t) for t in view.ros.tokens]
+    finally:
+        task.cancel()
+        view.close()
+    assert len(sent) == 1 and view.paths_sent == 1
+    path = wire.deserialize(sent[0], wire.PATH)
+    assert path.header.frame_id == "odom"
+    assert (path.header.stamp.sec, path.header.stamp.nanosec) == (7, 250_000_000)
+    assert [(p.pose.position.x, p.pose.position.y) for p in path.poses] == [
+        (0.0, 0.0), (1.0, 0.0), (1.0, 2.0)]
+    assert all(p.header.frame_id == "odom" for p in path.poses)
+    second = path.poses[1].pose.orientation  # facing the next point: +90 degrees
+    assert 2 * math.atan2(second.z, second.w) == pytest.approx(math.pi / 2)
+    assert ("MP", "/zenav/plan") in {(t.kind, t.topic) for t in tokens}

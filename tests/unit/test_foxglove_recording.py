@@ -7,6 +7,7 @@ import io
 import math
 from typing import Any
 
+import numpy as np
 import pytest
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
@@ -16,10 +17,12 @@ from zenav.bag.mcapfile import BagWriter
 from zenav.foxglove.scene import TOPICS
 from zenav.schemas.codec import encode
 from zenav.schemas.messages import (
+    GlobalPath,
     GroundTruth,
     Obstacle,
     ObstacleChain,
     ObstacleTruth,
+    OccupancyMap,
     PlannerEvent,
     Pose2D,
 )
@@ -48,29 +51,49 @@ def event(stamp: float) -> PlannerEvent:
                         action="morphin", detail="head-on")
 
 
-@pytest.fixture
-def decoded():
+def path(stamp: float) -> GlobalPath:
+    return GlobalPath(stamp=stamp, seq=0, points=np.array([[1.25, -0.5], [2.0, 0.5], [3.0, 4.0]]),
+                      reason="start")
+
+
+def record(messages: list[tuple[str, Any]]) -> tuple[dict[str, list[Any]], dict[str, str]]:
+    """Record zenav messages (topic, message) and decode the Foxglove channels."""
     stream = io.BytesIO()
     writer = BagWriter(stream, "r1", foxglove=True)
-    t = 12.5
-    for topic, sample in (("odom", samples.odometry(t)), ("scan", samples.scan(t)),
-                           ("obstacles", obstacle_chain(t)), ("tracks", samples.tracks(t)),
-                           ("planner/state", samples.state(t)), ("sim/truth", truth(t)),
-                           ("planner/events", event(t))):
+    for topic, sample in messages:
         writer.add(f"zenav/r1/{topic}", encode(sample), 20 * NS)
     writer.close()
     stream.seek(0)
     reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+    stamps = {round(sample.stamp * NS) for _, sample in messages}
     out: dict[str, list[Any]] = {}
     schemas = {}
     for schema, channel, message, proto in reader.iter_decoded_messages(
             topics=list(TOPICS)):
         assert schema is not None and channel.message_encoding == "protobuf"
         assert schema.encoding == "protobuf"
-        assert message.publish_time == 12_500_000_000 and message.log_time == 20 * NS
+        assert message.publish_time in stamps  # the zenav message's own stamp
+        assert message.log_time == 20 * NS
         schemas[channel.topic] = schema.name
         out.setdefault(channel.topic, []).append(proto)
     return out, schemas
+
+
+def occupancy(stamp: float) -> OccupancyMap:
+    cells = np.zeros((2, 3), dtype=np.int8)  # (iy, ix)
+    cells[0, 2], cells[1, 0] = 100, -1
+    return OccupancyMap(stamp=stamp, seq=0, origin=(-1.0, -0.5), resolution=0.25, width=3,
+                        height=2, cells=cells.ravel())
+
+
+@pytest.fixture
+def decoded():
+    t = 12.5
+    return record([("odom", samples.odometry(t)), ("scan", samples.scan(t)),
+                   ("obstacles", obstacle_chain(t)), ("tracks", samples.tracks(t)),
+                   ("planner/state", samples.state(t)), ("planner/path", path(t)),
+                   ("planner/map", occupancy(t)), ("sim/truth", truth(t)),
+                   ("planner/events", event(t))])
 
 
 def test_every_foxglove_topic_is_written_with_its_schema(decoded):
@@ -109,11 +132,45 @@ def test_scene_updates(decoded):
     assert entities["track-2"].arrows == []  # standing: no arrow
     obstacles = out["/foxglove/obstacles"][0].entities[0]
     assert obstacles.cylinders[0].pose.position.x == 2.0
-    plan = out["/foxglove/plan"][0].entities[0]
+    first, second = out["/foxglove/plan"]  # the state, then the path with the state
+    assert [e.id for e in first.entities] == ["plan"]
+    plan = first.entities[0]
     assert plan.texts[0].text == "(c) slow 0.10 m/s"
     assert [(p.x, p.y) for p in plan.lines[0].points] == [(1.25, -0.5), (3.0, 4.0)]
+    assert len(second.deletions) == 1
+    entities = {e.id: e for e in second.entities}
+    assert set(entities) == {"plan", "path"}
+    assert entities["plan"].texts[0].text == "(c) slow 0.10 m/s"
+    global_path = entities["path"]
+    assert global_path.frame_id == "odom" and len(global_path.lines) == 1
+    assert [(p.x, p.y) for p in global_path.lines[0].points] == [
+        (1.25, -0.5), (2.0, 0.5), (3.0, 4.0)]
     truth_entities = {e.id: e for e in out["/foxglove/truth"][0].entities}
     assert len(truth_entities["truth"].cylinders) == 1 and len(truth_entities["truth"].cubes) == 1
+
+
+def test_a_path_before_any_state_and_an_empty_path():
+    empty = GlobalPath(stamp=2.0, seq=1, points=np.zeros((0, 2)), reason="no way")
+    out, _ = record([("planner/path", path(1.0)), ("planner/path", empty),
+                     ("planner/state", samples.state(3.0))])
+    first, second, third = out["/foxglove/plan"]
+    assert [e.id for e in first.entities] == ["path"] and len(first.entities[0].lines) == 1
+    assert [e.id for e in second.entities] == ["path"]
+    assert len(second.entities[0].lines) == 0  # no way known: the old path is gone
+    assert [e.id for e in third.entities] == ["plan", "path"]
+
+
+def test_the_map_is_a_grid(decoded):
+    out, _ = decoded
+    (grid,) = out["/foxglove/map"]
+    assert grid.frame_id == "odom" and grid.column_count == 3
+    assert (grid.pose.position.x, grid.pose.position.y) == (-1.0, -0.5)
+    assert (grid.cell_size.x, grid.cell_size.y) == (0.25, 0.25)
+    assert (grid.row_stride, grid.cell_stride) == (3, 1)
+    (field,) = grid.fields
+    assert (field.name, field.offset, field.type) == ("occupancy", 0, 2)  # INT8
+    cells = np.frombuffer(grid.data, dtype=np.int8).reshape(2, 3)
+    assert cells[0, 2] == 100 and cells[1, 0] == -1 and cells.sum() == 99
 
 
 def test_planner_events_are_log_lines(decoded):

@@ -5,18 +5,30 @@ planner's log, and a plot of the robot's position."""
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 
 import foxglove.layouts as fl
 
 from zenav.foxglove.scene import BASE, ODOM, TOPICS
 
 
+def _grid_settings() -> fl.BaseRendererGridTopicSettings:
+    """The occupancy map: free cells faint, occupied ones dark, unknown ones (-1, below
+    the range) as faint as free, drawn behind the scene."""
+    return fl.BaseRendererGridTopicSettings(
+        visible=True, color_mode="gradient", color_field="occupancy",
+        gradient=("#ffffff10", "#303030e0"), min_value=0.0, max_value=100.0,
+        draw_behind=True)
+
+
 def _topic_settings() -> dict[str, fl.BaseRendererTopicSettings]:
     """Every 3D topic visible, each with the settings type of its message."""
-    kinds = {"LaserScan": fl.BaseRendererLaserScanTopicSettings,
-             "PoseInFrame": fl.BaseRendererPoseTopicSettings,
-             "SceneUpdate": fl.BaseRendererSceneUpdateTopicSettings}
-    return {topic: kinds[kind.__name__](visible=True) for topic, kind in TOPICS.items()
+    kinds: dict[str, Callable[[], fl.BaseRendererTopicSettings]] = {
+        "LaserScan": lambda: fl.BaseRendererLaserScanTopicSettings(visible=True),
+        "PoseInFrame": lambda: fl.BaseRendererPoseTopicSettings(visible=True),
+        "SceneUpdate": lambda: fl.BaseRendererSceneUpdateTopicSettings(visible=True),
+        "Grid": _grid_settings}
+    return {topic: kinds[kind.__name__]() for topic, kind in TOPICS.items()
             if kind.__name__ in kinds}
 
 

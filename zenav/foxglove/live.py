@@ -101,8 +101,8 @@ def add_command(sub: Any) -> None:
     parser = sub.add_parser(
         "foxglove", help="serve a robot's messages live to Foxglove (WebSocket, read-only)",
         description="Foxglove's WebSocket protocol through the Foxglove SDK's server: the "
-        "scan, the robot's frames and pose, obstacles, tracks, the planner's target and "
-        "events, and ground truth in simulation. --connect ENDPOINT joins a router as a "
+        "scan, the robot's frames and pose, obstacles, tracks, the planner's target, global path, "
+        "map and events, and ground truth in simulation. --connect ENDPOINT joins a router as a "
         "client from any host.")
     parser.add_argument("--host", default="127.0.0.1",
                         help="address to serve on (default 127.0.0.1; 0.0.0.0 for any host)")

@@ -11,7 +11,11 @@ Topics (all under ``/foxglove/``), frames ``odom`` (the world: zenav's poses),
 - ``tracks``: ``foxglove.SceneUpdate``, tracks coloured by type (new yellow, static grey,
   dynamic red) with an arrow of one second's travel and the track id;
 - ``plan``: ``foxglove.SceneUpdate``, the planner's line to its current (sub-)target with
-  its scenario letter and action (the full global path once the planner publishes one);
+  its scenario letter and action, and its latest global path (``planner/path``) as a
+  blue line from the robot to the goal (each update carries both, since it replaces the
+  last one);
+- ``map``: ``foxglove.Grid``, the planner's occupancy map (``planner/map``): one INT8
+  field ``occupancy`` per cell, -1 unknown, 0 free, 100 occupied, as ROS draws it;
 - ``truth``: ``foxglove.SceneUpdate``, the simulator's ground truth (green, translucent);
 - ``log``: ``foxglove.Log``, one line per planner event.
 """
@@ -25,10 +29,12 @@ import numpy as np
 from foxglove import messages as fm
 
 from zenav.schemas.messages import (
+    GlobalPath,
     GroundTruth,
     LaserScan,
     Message,
     ObstacleChain,
+    OccupancyMap,
     Odometry,
     PlannerEvent,
     PlannerState,
@@ -47,6 +53,7 @@ TOPICS: dict[str, type[Any]] = {
     "/foxglove/obstacles": fm.SceneUpdate,
     "/foxglove/tracks": fm.SceneUpdate,
     "/foxglove/plan": fm.SceneUpdate,
+    "/foxglove/map": fm.Grid,
     "/foxglove/truth": fm.SceneUpdate,
     "/foxglove/log": fm.Log,
 }
@@ -145,8 +152,28 @@ def tracks(track_list: TrackList) -> fm.SceneUpdate:
     return _update(track_list.stamp, entities)
 
 
-def plan(state: PlannerState, odometry: Odometry | None) -> fm.SceneUpdate:
-    """The line from the robot to the planner's current target, and its decision."""
+def path_entity(path: GlobalPath) -> fm.SceneEntity:
+    """The global path as a line strip, robot to goal (no line when no way is known)."""
+    points = [fm.Point3(x=float(x), y=float(y), z=0.03) for x, y in path.points]
+    lines = [] if len(points) < 2 else [fm.LinePrimitive(
+        type=fm.LinePrimitiveLineType.LineStrip, pose=pose(0.0, 0.0), thickness=0.03,
+        scale_invariant=False, points=points, color=colour((0.2, 0.6, 1.0, 0.9)))]
+    return _entity(path.stamp, "path", lines=lines)
+
+
+def plan(state: PlannerState | None, odometry: Odometry | None,
+         path: GlobalPath | None = None) -> fm.SceneUpdate:
+    """The line from the robot to the planner's current target and its decision, and the
+    global path; stamped with the newer of the two."""
+    entities = [] if path is None else [path_entity(path)]
+    stamps = [m.stamp for m in (state, path) if m is not None]
+    stamp = max(stamps) if stamps else 0.0
+    if state is not None:
+        entities.insert(0, _target_entity(state, odometry))
+    return _update(stamp, entities)
+
+
+def _target_entity(state: PlannerState, odometry: Odometry | None) -> fm.SceneEntity:
     tx, ty = state.target
     x, y = (odometry.pose.x, odometry.pose.y) if odometry is not None else (tx, ty)
     line = fm.LinePrimitive(type=fm.LinePrimitiveLineType.LineStrip, pose=pose(0.0, 0.0),
@@ -156,7 +183,19 @@ def plan(state: PlannerState, odometry: Odometry | None) -> fm.SceneUpdate:
     text = fm.TextPrimitive(pose=pose(x, y, z=HEIGHT + 0.5), billboard=True, font_size=16.0,
                             scale_invariant=True, color=colour((1, 1, 1, 1)),
                             text=f"({state.scenario}) {state.action} {state.speed:.2f} m/s")
-    return _update(state.stamp, [_entity(state.stamp, "plan", lines=[line], texts=[text])])
+    return _entity(state.stamp, "plan", lines=[line], texts=[text])
+
+
+def occupancy_grid(occupancy: OccupancyMap) -> fm.Grid:
+    """The map as a grid of one INT8 field, rows along y from the map's origin."""
+    ox, oy = occupancy.origin
+    r = occupancy.resolution
+    return fm.Grid(timestamp=timestamp(occupancy.stamp), frame_id=ODOM, pose=pose(ox, oy),
+                   column_count=occupancy.width, cell_size=fm.Vector2(x=r, y=r),
+                   row_stride=occupancy.width, cell_stride=1,
+                   fields=[fm.PackedElementField(
+                       name="occupancy", offset=0, type=fm.PackedElementFieldNumericType.Int8)],
+                   data=np.ascontiguousarray(occupancy.cells, dtype=np.int8).tobytes())
 
 
 def truth(ground: GroundTruth) -> fm.SceneUpdate:
@@ -189,10 +228,13 @@ def log(event: PlannerEvent) -> fm.Log:
 
 class SceneBuilder:
     """zenav messages in, (Foxglove topic, message) pairs out; keeps the latest odometry
-    for the plan line."""
+    for the plan line, and the latest planner state and global path, which share the
+    plan scene."""
 
     def __init__(self) -> None:
         self.odometry: Odometry | None = None
+        self.state: PlannerState | None = None
+        self.path: GlobalPath | None = None
 
     def convert(self, message: Message) -> list[tuple[str, Any]]:
         if isinstance(message, LaserScan):
@@ -208,7 +250,13 @@ class SceneBuilder:
         if isinstance(message, TrackList):
             return [("/foxglove/tracks", tracks(message))]
         if isinstance(message, PlannerState):
-            return [("/foxglove/plan", plan(message, self.odometry))]
+            self.state = message
+            return [("/foxglove/plan", plan(message, self.odometry, self.path))]
+        if isinstance(message, GlobalPath):
+            self.path = message
+            return [("/foxglove/plan", plan(self.state, self.odometry, message))]
+        if isinstance(message, OccupancyMap):
+            return [("/foxglove/map", occupancy_grid(message))]
         if isinstance(message, GroundTruth):
             return [("/foxglove/truth", truth(message))]
         if isinstance(message, PlannerEvent):
