@@ -74,7 +74,7 @@ class _IdleSelector(selectors.BaseSelector):
 
     def select(self, timeout: float | None = None) -> list[tuple[selectors.SelectorKey, int]]:
         ready = self._inner.select(0)
-        if ready or timeout is not None and timeout <= 0:
+        if ready or (timeout is not None and timeout <= 0):
             return ready
         if timeout is None:  # nothing scheduled at all: only I/O (a signal) can wake us
             return self._inner.select(1.0)
@@ -109,6 +109,29 @@ def read_back(name: str, values: Mapping[str, Any], planner: str = "paper") -> A
     text = yaml.safe_dump(dict(values), sort_keys=False)
     layer = Layer("file", f"{name} parameters", yaml.safe_load(text) or {})
     return resolve(implementation(name, planner).Params, [layer])[0]
+
+
+IGNORED = frozenset({"wall_time", "engine", "unclean_exits"})
+"""Record fields that say how a run was made, not what happened in it."""
+
+
+def first_difference(stack: Mapping[str, Any], inprocess: Mapping[str, Any]) -> str | None:
+    """Where two run records part: the first trajectory row, the first event, or the first
+    other field that differs (``None`` when they are the same run)."""
+    rows_a, rows_b = stack.get("trajectory", []), inprocess.get("trajectory", [])
+    for i, (a, b) in enumerate(zip(rows_a, rows_b, strict=False)):
+        if a != b:
+            return f"trajectory row {i}: stack {a} vs in-process {b}"
+    if len(rows_a) != len(rows_b):
+        return f"trajectory lengths: stack {len(rows_a)} vs in-process {len(rows_b)}"
+    events_a, events_b = stack.get("events", []), inprocess.get("events", [])
+    for i, (a, b) in enumerate(zip(events_a, events_b, strict=False)):
+        if a != b:
+            return f"event {i}: stack {a} vs in-process {b}"
+    for name in sorted((set(stack) | set(inprocess)) - IGNORED):
+        if stack.get(name) != inprocess.get(name):
+            return f"{name}: stack {stack.get(name)!r} vs in-process {inprocess.get(name)!r}"
+    return None
 
 
 @dataclass

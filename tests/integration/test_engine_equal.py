@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 
+from zenav.engine import first_difference
 from zenav.run import run_scenario
 from zenav.sim import SCENARIO_DIR
 from zenav.sim.generate import random_scenario
@@ -28,27 +29,6 @@ AGENT_WORLDS: tuple[tuple[str, int], ...] = ()
 """Worlds with agents (obstacles with a behaviour of their own) join here once the
 simulator has them: (family, seed) pairs of :func:`random_scenario`, e.g. the crowd
 family with agents, run exactly like ``RANDOM``."""
-
-IGNORED = {"wall_time", "engine", "unclean_exits"}
-"""Record fields that say how the run was made, not what happened in it."""
-
-
-def first_difference(stack: dict[str, Any], inprocess: dict[str, Any]) -> str | None:
-    """Where two run records part: the first trajectory row or event, or a field."""
-    for i, (a, b) in enumerate(zip(stack["trajectory"], inprocess["trajectory"], strict=False)):
-        if a != b:
-            return f"trajectory row {i}: stack {a} vs in-process {b}"
-    if len(stack["trajectory"]) != len(inprocess["trajectory"]):
-        return (f"trajectory lengths: stack {len(stack['trajectory'])} vs in-process "
-                f"{len(inprocess['trajectory'])}")
-    for i, (a, b) in enumerate(zip(stack["events"], inprocess["events"], strict=False)):
-        if a != b:
-            return f"event {i}: stack {a} vs in-process {b}"
-    for name in sorted((set(stack) | set(inprocess)) - IGNORED):
-        if stack.get(name) != inprocess.get(name):
-            return f"{name}: stack {stack.get(name)!r} vs in-process {inprocess.get(name)!r}"
-    return None
-
 
 def _worlds(tmp: Path) -> list[Path]:
     paths = [*PAPER, *EXPERIMENTS]
