@@ -252,6 +252,11 @@ class InMemoryBus(Bus):
     def declare_queryable(self, key: str, snapshot: Snapshot) -> None:
         self._queryables.append((key, snapshot))
 
+    def stop_watching(self) -> None:
+        """Forget every liveliness watcher (a stack in one process stopping: nobody is
+        left to be told who went away)."""
+        self._watchers.clear()
+
     async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
         return [(key, payload) for key, snapshot in self._queryables
                 if key_matches(selector, key) for payload in snapshot()]

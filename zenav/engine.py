@@ -237,6 +237,7 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
         # The simulator first, so that it does not log the others going away.
         nodes["simulator"].request_stop()
         await asyncio.gather(spins["simulator"], return_exceptions=True)
+        bus.stop_watching()
         token.undeclare()
         for node in nodes.values():
             node.request_stop()
