@@ -81,3 +81,52 @@ def lockstep_table(rows: list[LockstepRow]) -> str:
                  f"in the simulator's loop, {sim / wall:.1f}× for the whole command with the "
                  f"processes' start and stop ({verdict(factor >= TARGET_LOCKSTEP_FACTOR)}).")
     return "\n".join(lines)
+
+
+TARGET_ENGINE_FACTOR = 300.0
+TARGET_COMMAND_FACTOR = 30.0
+
+
+@dataclass
+class EngineRow:
+    scenario: str
+    outcome: str
+    sim_time: float
+    wall: float
+
+
+def measure_engine(work: Path, scenarios: tuple[Path, ...] = PAPER_SCENARIOS,
+                   planner: str = "paper") -> list[EngineRow]:
+    """The in-process engine (``zenav run --engine inprocess``, without the picture) on
+    each scenario in this process, once the modules are imported: simulated s and wall s."""
+    import time
+
+    from zenav.run import run_scenario
+
+    rows = []
+    for path in scenarios:
+        started = time.perf_counter()
+        record = run_scenario(path, work / "engine" / path.stem, planner=planner,
+                              picture=False, engine="inprocess", log_level="WARNING")
+        rows.append(EngineRow(path.stem, record["outcome"], record["time"],
+                              time.perf_counter() - started))
+    return rows
+
+
+def engine_factor(rows: list[EngineRow]) -> float:
+    return sum(r.sim_time for r in rows) / sum(r.wall for r in rows)
+
+
+def engine_table(rows: list[EngineRow]) -> str:
+    lines = ["| scenario | outcome | simulated s | wall s | × real time |", "|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r.scenario} | {r.outcome} | {r.sim_time:.1f} | {r.wall:.2f} | "
+                     f"{r.sim_time / r.wall:.1f} |")
+    sim = sum(r.sim_time for r in rows)
+    wall = sum(r.wall for r in rows)
+    factor = engine_factor(rows)
+    lines.append(f"| **all** | | {sim:.1f} | {wall:.2f} | **{factor:.1f}** |")
+    lines.append("")
+    lines.append(f"Target: ≥ {TARGET_ENGINE_FACTOR:g}× real time — measured {factor:.1f}× "
+                 f"({verdict(factor >= TARGET_ENGINE_FACTOR)}).")
+    return "\n".join(lines)
