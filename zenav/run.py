@@ -160,12 +160,14 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
                                f"another arriving; still waiting on {missing}")
             with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(everyone.wait(), timeout=0.1)
-        token = bus.declare_token(k.alive("run"))
+        # Subscribed before the run is announced: the first events come at once, and
+        # the history query alone can miss them when it times out on a loaded machine.
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
         odom = bus.subscribe(k.of(keys.ODOM), depth=1)
         paths = bus.subscribe(k.of(keys.PATH), depth=1)
         maps = bus.subscribe(k.of(keys.MAP), depth=1)
+        token = bus.declare_token(k.alive("run"))
         events: list[PlannerEvent] = []
         last_progress = time.monotonic()
         sim_time = -1.0
