@@ -12,7 +12,7 @@ job's own directory, on one of two engines:
   printed loudly and kept in :attr:`Records.disagreements`.
 
 ``zenav paper``, ``zenav bench nav`` (and the crowd benchmark) run their jobs here. Ctrl-C
-stops the worker processes at once (they ignore SIGINT; the pool is terminated).
+stops the worker processes at once (they ignore SIGINT and are killed).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import random
 import signal
 import sys
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -104,9 +104,14 @@ def _worker_start() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _worker_job(task: tuple[Job, dict[str, Any]]) -> tuple[Job, dict[str, Any]]:
-    job, options = task
-    return job, run_job(job, **options)
+def stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's worker processes now (they ignore SIGINT) and drop what is queued."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.join(timeout=1.0)
 
 
 def sample(jobs: list[Job], count: int, seed: int = 0) -> list[Job]:
@@ -166,16 +171,15 @@ def run_batch(jobs: Iterable[Job], parallel: int,
                 done(futures[future], future.result())
         return records
     context = multiprocessing.get_context("forkserver" if sys.platform != "win32" else "spawn")
-    pool = context.Pool(max(1, parallel), initializer=_worker_start)
+    pool = ProcessPoolExecutor(max(1, parallel), mp_context=context, initializer=_worker_start)
     try:
-        for job, record in pool.imap_unordered(_worker_job, [(j, options) for j in job_list]):
-            done(job, record)
-        pool.close()
+        futures = {pool.submit(run_job, job, **options): job for job in job_list}
+        for future in as_completed(futures):
+            done(futures[future], future.result())
     except BaseException:
-        pool.terminate()  # Ctrl-C or a failed job: no worker outlives the batch
+        stop_workers(pool)  # Ctrl-C or a failed job: no worker outlives the batch
         raise
-    finally:
-        pool.join()
+    pool.shutdown(wait=True)
     if verify > 0:
         say = echo or (lambda text: print(text, file=sys.stderr))
         chosen = sample(job_list, verify, verify_seed)
