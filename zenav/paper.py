@@ -319,16 +319,11 @@ def machine_description() -> str:
     return f"{os.cpu_count()} cores ({cpu_model()}), Python {platform.python_version()}"
 
 
-<<<<<<< HEAD
 def main(out: Path, quick: bool = False, parallel: int = 2,
-         profiles: tuple[str, ...] = PROFILES, reuse: bool = False) -> Path:
+         profiles: tuple[str, ...] = PROFILES, reuse: bool = False, engine: str = "stack",
+         verify: int = DEFAULT_VERIFY) -> Path:
     """Run the experiments with a progress bar, draw the figures, write the report.
     ``reuse``: a run whose ``run.json`` is already in ``out`` is not run again."""
-=======
-def main(out: Path, quick: bool = False, parallel: int = 2, engine: str = "stack",
-         verify: int = DEFAULT_VERIFY) -> Path:
-    """Run the experiments with a progress bar, draw the figures, write the report."""
->>>>>>> 57ed9e4 (Batch runner: --engine inprocess runs jobs in forkserver worker processes (--jobs, default the cores), re-makes a seeded sample through the stack (--verify) and says loudly if they disagree; bench nav and paper take the options)
     import time
 
     from rich.progress import (
@@ -343,26 +338,18 @@ def main(out: Path, quick: bool = False, parallel: int = 2, engine: str = "stack
     jobs = plan_jobs(out, quick, profiles)
     with Progress(TextColumn("[bold]zenav paper"), BarColumn(), TextColumn("{task.completed}/"
                   "{task.total} runs"), TextColumn("{task.description}"),
-<<<<<<< HEAD
-                  TimeElapsedColumn()) as progress:
-        task = progress.add_task("", total=len(jobs) + 2)
-=======
                   TimeElapsedColumn(), TimeRemainingColumn()) as progress:
-        task = progress.add_task("", total=len(jobs) + 1)
+        task = progress.add_task("", total=len(jobs) + 2)
         finished: list[bool] = []
->>>>>>> 57ed9e4 (Batch runner: --engine inprocess runs jobs in forkserver worker processes (--jobs, default the cores), re-makes a seeded sample through the stack (--verify) and says loudly if they disagree; bench nav and paper take the options)
 
         def done(job: Job, record: dict[str, Any]) -> None:
             finished.append(record["outcome"] == "reached")
             progress.update(task, advance=1, description=f"{sum(finished)}/{len(finished)} "
                             f"reached; {job.key}")
 
-<<<<<<< HEAD
         # keep_going: a run that fails is a result of the report, not the end of it
-        records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse)
-=======
-        records = run_batch(jobs, parallel, done, engine=engine, verify=verify)
->>>>>>> 57ed9e4 (Batch runner: --engine inprocess runs jobs in forkserver worker processes (--jobs, default the cores), re-makes a seeded sample through the stack (--verify) and says loudly if they disagree; bench nav and paper take the options)
+        records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse, engine=engine,
+                            verify=verify)
         progress.update(task, description="figures")
         make_figures(out, jobs, records)
         progress.update(task, advance=1, description="typing accuracy")
@@ -377,13 +364,8 @@ def _command(args: argparse.Namespace) -> int:
 
     profiles = PROFILES if args.profile == "both" else (args.profile,)
     try:
-<<<<<<< HEAD
         report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
-                      reuse=args.reuse)
-=======
-        report = main(args.out, quick=args.quick, parallel=args.parallel, engine=args.engine,
-                      verify=args.verify)
->>>>>>> 57ed9e4 (Batch runner: --engine inprocess runs jobs in forkserver worker processes (--jobs, default the cores), re-makes a seeded sample through the stack (--verify) and says loudly if they disagree; bench nav and paper take the options)
+                      reuse=args.reuse, engine=args.engine, verify=args.verify)
     except RunError as exc:
         print(f"zenav paper: {exc}", file=sys.stderr)
         return 1
@@ -395,24 +377,19 @@ def add_command(sub: Any) -> None:
     paper = sub.add_parser("paper", help="reproduce the paper's experiments as a report")
     paper.add_argument("--out", type=Path, default=Path("out/paper"), help="report directory")
     paper.add_argument("--quick", action="store_true",
-<<<<<<< HEAD
                        help="scenario (a) once per profile only (a smoke test of the report)")
-    paper.add_argument("--parallel", type=int, default=2, help="runs at once (default 2)")
+    paper.add_argument("--jobs", "--parallel", dest="parallel", type=int,
+                       default=default_jobs(), help="runs at once (default: the cores)")
     paper.add_argument("--profile", choices=("both", *PROFILES), default="both",
                        help="parameter profile(s) to run: both (default, side by side), "
                             "zenav or paper")
     paper.add_argument("--reuse", action="store_true",
                        help="take a run.json already under --out as that run's record "
                             "(finish or redraw an interrupted report)")
-=======
-                       help="scenario (a) once only (a smoke test of the report)")
-    paper.add_argument("--jobs", "--parallel", dest="parallel", type=int,
-                       default=default_jobs(), help="runs at once (default: the cores)")
     paper.add_argument("--engine", choices=ENGINES, default="stack",
                        help="stack (default): six processes over Zenoh per run; inprocess: "
                        "the same services in one process per run, worker processes in parallel")
     paper.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
                        help="with --engine inprocess: runs re-made through the stack and "
                        f"compared tick by tick (default {DEFAULT_VERIFY})")
->>>>>>> 57ed9e4 (Batch runner: --engine inprocess runs jobs in forkserver worker processes (--jobs, default the cores), re-makes a seeded sample through the stack (--verify) and says loudly if they disagree; bench nav and paper take the options)
     paper.set_defaults(func=_command)
