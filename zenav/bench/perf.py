@@ -121,14 +121,15 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
                 text = ("## Lockstep simulation speed (zenav run, paper planner)\n\n"
                         + lockstep_table(steps))
             elif section == "engine":
-                rows = measure_engine(work)
-                factor = engine_factor(rows)
+                engine_rows = measure_engine(work)
+                factor = engine_factor(engine_rows)
                 figures["in-process engine, paper scenarios"] = (
-                    f"{factor:.1f}× real time ({engine_factor(rows, cpu=True):.1f}× per CPU s)",
-                    f"≥ {TARGET_ENGINE_FACTOR:g}×",
-                    factor >= TARGET_ENGINE_FACTOR)
+                    f"{factor:.1f}× real time "
+                    f"({engine_factor(engine_rows, cpu=True):.1f}× per CPU s)",
+                    f"≥ {TARGET_ENGINE_FACTOR:g}×", factor >= TARGET_ENGINE_FACTOR)
                 text = ("## In-process engine speed (zenav run --engine inprocess, paper "
-                        "planner, eight paper scenarios, one process)\n\n" + engine_table(rows))
+                        "planner, eight paper scenarios, one process)\n\n"
+                        + engine_table(engine_rows))
             elif section == "rate":
                 rows = []
                 for rate in rates:
