@@ -38,16 +38,6 @@ def _worlds(tmp: Path) -> list[Path]:
     return paths
 
 
-def test_first_difference_finds_the_row(tmp_path: Path) -> None:
-    record = {"trajectory": [[0.0, 1.0, 2.0, 0.0, 0.0], [0.1, 1.1, 2.0, 0.0, 0.1]],
-              "events": [], "outcome": "reached", "wall_time": 1.0}
-    other = {**record, "trajectory": [record["trajectory"][0], [0.1, 1.1, 2.0, 0.0, 0.2]],
-             "wall_time": 9.0}
-    assert first_difference(record, dict(record, wall_time=5.0)) is None
-    assert first_difference(record, other) == ("trajectory row 1: stack [0.1, 1.1, 2.0, 0.0, "
-                                               "0.1] vs in-process [0.1, 1.1, 2.0, 0.0, 0.2]")
-
-
 def test_the_engines_agree_tick_by_tick(tmp_path: Path) -> None:
     worlds = _worlds(tmp_path)
 

@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from zenav.schemas.messages import ObstacleKind
 from zenav.services.planner.prediction import Obstacle, assess, assess_all
 
-KINDS = ("new", "static", "dynamic")
+KINDS: tuple[ObstacleKind, ...] = ("new", "static", "dynamic")
 
 
 def random_obstacles(rng: np.random.Generator, count: int, cell: float) -> list[Obstacle]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -84,14 +85,15 @@ def test_parameters_are_read_back_as_a_service_process_reads_them(service: str,
 
 
 def test_first_difference_names_the_row_the_event_or_the_field() -> None:
-    record = {"trajectory": [[0.0, 1.0, 2.0, 0.0, 0.0], [0.1, 1.1, 2.0, 0.0, 0.1]],
-              "events": [{"t": 0.0, "action": "keep"}], "outcome": "reached",
-              "wall_time": 1.0}
+    rows = [[0.0, 1.0, 2.0, 0.0, 0.0], [0.1, 1.1, 2.0, 0.0, 0.1]]
+    record: dict[str, Any] = {"trajectory": rows, "events": [{"t": 0.0, "action": "keep"}],
+                              "outcome": "reached", "wall_time": 1.0}
     assert first_difference(record, {**record, "wall_time": 5.0, "engine": "inprocess"}) is None
-    moved = {**record, "trajectory": [record["trajectory"][0], [0.1, 1.1, 2.0, 0.0, 0.2]]}
+    moved = {**record, "trajectory": [rows[0], [0.1, 1.1, 2.0, 0.0, 0.2]]}
     assert first_difference(record, moved) == ("trajectory row 1: stack [0.1, 1.1, 2.0, 0.0, "
                                                "0.1] vs in-process [0.1, 1.1, 2.0, 0.0, 0.2]")
     other_event = {**record, "events": [{"t": 0.0, "action": "stop"}]}
-    assert first_difference(record, other_event).startswith("event 0: ")
+    where = first_difference(record, other_event)
+    assert where is not None and where.startswith("event 0: ")
     assert first_difference(record, {**record, "outcome": "timeout"}) == (
         "outcome: stack 'reached' vs in-process 'timeout'")
