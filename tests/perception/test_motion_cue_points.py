@@ -30,7 +30,8 @@ def scan(stamp: float, pose: tuple[float, float, float],
 def clusters_of(s: ScanSnapshot) -> np.ndarray:
     hit = s.ranges < 8.0
     edges = np.flatnonzero(np.diff(np.r_[0, hit.astype(int), 0]))
-    return edges.reshape(-1, 2) - np.array([0, 1])
+    beams: np.ndarray = edges.reshape(-1, 2) - np.array([0, 1])
+    return beams
 
 
 @pytest.mark.parametrize("seed", range(5))
