@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import json
 import logging
 import uuid
@@ -169,8 +170,10 @@ class Bus(ABC):
 # --- in memory ------------------------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=4096)
 def key_matches(key_expr: str, key: str) -> bool:
-    """Zenoh's own key-expression intersection, for the in-memory bus."""
+    """Zenoh's own key-expression intersection, for the in-memory bus (remembered: a
+    stack uses a few dozen keys, each matched on every message)."""
     return bool(zenoh.KeyExpr(key_expr).intersects(zenoh.KeyExpr(key)))
 
 
@@ -196,10 +199,11 @@ class InMemoryBus(Bus):
     """A bus inside one process and one asyncio loop, for service tests.
 
     Several services can share one instance; ``published`` keeps every put for
-    assertions.
+    assertions (unless ``keep_published`` is false: a long run in the in-process engine).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, *, keep_published: bool = True) -> None:
+        self.keep_published = keep_published
         self._subs: list[Subscription] = []
         self._alive: set[str] = set()
         self._watchers: list[tuple[str, LivelinessCallback]] = []
@@ -209,9 +213,10 @@ class InMemoryBus(Bus):
         """Attachments sent, by index into ``published``."""
 
     def deliver(self, key: str, payload: bytes, attachment: bytes | None = None) -> None:
-        if attachment is not None:
-            self.attachments[len(self.published)] = attachment
-        self.published.append((key, payload))
+        if self.keep_published:
+            if attachment is not None:
+                self.attachments[len(self.published)] = attachment
+            self.published.append((key, payload))
         for sub in list(self._subs):
             if key_matches(sub.key_expr, key):
                 sub.push(key, payload)
@@ -246,6 +251,11 @@ class InMemoryBus(Bus):
 
     def declare_queryable(self, key: str, snapshot: Snapshot) -> None:
         self._queryables.append((key, snapshot))
+
+    def stop_watching(self) -> None:
+        """Forget every liveliness watcher (a stack in one process stopping: nobody is
+        left to be told who went away)."""
+        self._watchers.clear()
 
     async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
         return [(key, payload) for key, snapshot in self._queryables

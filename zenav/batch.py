@@ -1,21 +1,49 @@
-"""One batch runner: many scenario runs through ``zenav run``'s path, a few at a time.
+"""One batch runner: many scenario runs through ``zenav run``'s path, several at a time.
 
-Each job is :func:`zenav.run.run_scenario` (six service processes over Zenoh, lockstep on
-the simulated clock) in a worker thread, with its ``run.json`` and ``run.png`` in the
-job's own directory. ``zenav paper`` and ``zenav bench nav`` run their jobs here.
+Each job is :func:`zenav.run.run_scenario` with its ``run.json`` (and ``run.png``) in the
+job's own directory, on one of two engines:
+
+- ``stack``: six service processes over Zenoh per run; jobs run in worker threads
+  (each run is already its own processes).
+- ``inprocess``: the same services in one process (:mod:`zenav.engine`); jobs run in a
+  pool of worker processes (forkserver), one run at a time per worker, each run seeded
+  from its scenario file only. A seeded sample of ``verify`` jobs is then run again
+  through the stack and the two records compared tick by tick; any disagreement is
+  printed loudly and kept in :attr:`Records.disagreements`.
+
+``zenav paper``, ``zenav bench nav`` (and the crowd benchmark) run their jobs here. Ctrl-C
+stops the worker processes at once (they ignore SIGINT and are killed).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import multiprocessing
+import os
+import random
+import signal
+import sys
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from zenav.engine import ENGINES, first_difference
 from zenav.run import run_scenario
 from zenav.sim.scenario import load_scenario
+
+DEFAULT_VERIFY = 3
+"""In-process jobs re-run through the stack to show the two engines agree."""
+
+
+def default_jobs() -> int:
+    """Runs at a time unless told: the cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
 
 
 @dataclass(frozen=True)
@@ -33,46 +61,138 @@ class Job:
         return self.scenario.stem
 
 
+class Records(dict[str, dict[str, Any]]):
+    """The records by job key, and what the stack said of the sample re-run through it."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.verified: list[str] = []  # job keys re-run through the stack
+        self.disagreements: list[str] = []  # "key: where the records part"
+
+
 def error_record(job: Job, error: str) -> dict[str, Any]:
     """The record of a run that failed: outcome ``error`` and the one-line reason."""
     return {"scenario": job.name, "planner": job.planner, "outcome": "error", "error": error}
 
 
 def run_job(job: Job, *, log_level: str = "INFO", reuse: bool = False,
-            keep_going: bool = False) -> dict[str, Any]:
+            keep_going: bool = False, engine: str = "stack",
+            picture: bool = True) -> dict[str, Any]:
     """One run; its record. ``reuse``: a ``run.json`` already in ``job.out`` is the record.
-    ``keep_going``: a failed run gives an :func:`error_record` instead of raising."""
+    ``keep_going``: a failed run gives an :func:`error_record` instead of raising.
+    ``picture``: draw ``run.png`` too."""
     record_path = job.out / "run.json"
     if reuse and record_path.exists():
         reused: dict[str, Any] = json.loads(record_path.read_text())
         return reused
     try:
         record = run_scenario(job.scenario, job.out, planner=job.planner, log_level=log_level,
-                              picture=False, profile=job.profile)
+                              picture=False, profile=job.profile, engine=engine)
     except Exception as exc:
         if not keep_going:
             raise
         return error_record(job, (str(exc).strip().splitlines() or [type(exc).__name__])[-1])
-    from zenav.plot import plot_run  # matplotlib is slow to import; only here
+    if picture:
+        from zenav.plot import plot_run  # matplotlib is slow to import; only here
 
-    plot_run(load_scenario(job.scenario), record, job.out / "run.png")
+        plot_run(load_scenario(job.scenario), record, job.out / "run.png")
     return record
+
+
+def _worker_start() -> None:
+    """A worker process leaves Ctrl-C to the parent, which terminates the pool."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's worker processes now (they ignore SIGINT) and drop what is queued."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.join(timeout=1.0)
+
+
+def sample(jobs: list[Job], count: int, seed: int = 0) -> list[Job]:
+    """``count`` of ``jobs`` chosen by ``seed`` (the same jobs for the same list)."""
+    return random.Random(seed).sample(jobs, min(count, len(jobs)))
+
+
+def verify_with_stack(jobs: list[Job], records: dict[str, dict[str, Any]], parallel: int,
+                      *, log_level: str = "WARNING") -> tuple[list[str], list[str]]:
+    """Run ``jobs`` again through the stack (records in ``OUT/stack-check``); the keys
+    checked and, for each that disagrees with ``records``, where the records part."""
+    checked: list[str] = []
+    disagreements: list[str] = []
+    candidates = [job for job in jobs if records.get(job.key, {}).get("outcome") != "error"]
+
+    def again(job: Job) -> tuple[Job, dict[str, Any]]:
+        redo = dataclasses.replace(job, out=job.out / "stack-check")
+        return job, run_job(redo, log_level=log_level, keep_going=True, picture=False)
+
+    with ThreadPoolExecutor(max(1, parallel)) as pool:
+        for job, stack in pool.map(again, candidates):
+            checked.append(job.key)
+            if stack["outcome"] == "error":
+                disagreements.append(f"{job.key}: the stack run failed: {stack.get('error')}")
+                continue
+            where = first_difference(stack, records[job.key])
+            if where is not None:
+                disagreements.append(f"{job.key}: {where}")
+    return checked, disagreements
 
 
 def run_batch(jobs: Iterable[Job], parallel: int,
               on_done: Callable[[Job, dict[str, Any]], None] | None = None, *,
-              log_level: str = "INFO", reuse: bool = False,
-              keep_going: bool = False) -> dict[str, dict[str, Any]]:
+              log_level: str = "INFO", reuse: bool = False, keep_going: bool = False,
+              engine: str = "stack", verify: int = DEFAULT_VERIFY, verify_seed: int = 0,
+              picture: bool = True, echo: Callable[[str], None] | None = None) -> Records:
     """Run every job, ``parallel`` at a time; the records by job key. ``on_done`` is
-    called (in this thread) as each job ends; for the options see :func:`run_job`."""
-    records: dict[str, dict[str, Any]] = {}
-    with ThreadPoolExecutor(max(1, parallel)) as pool:
-        futures = {pool.submit(run_job, job, log_level=log_level, reuse=reuse,
-                               keep_going=keep_going): job for job in jobs}
+    called (in this thread) as each job ends; for the options see :func:`run_job`.
+    With ``engine="inprocess"``, ``verify`` jobs (chosen by ``verify_seed``) are re-run
+    through the stack afterwards; disagreements go to ``echo`` (stderr by default)."""
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; choose from {', '.join(ENGINES)}")
+    job_list = list(jobs)
+    records = Records()
+    options: dict[str, Any] = {"log_level": log_level, "reuse": reuse,
+                               "keep_going": keep_going, "engine": engine, "picture": picture}
+
+    def done(job: Job, record: dict[str, Any]) -> None:
+        records[job.key] = record
+        if on_done is not None:
+            on_done(job, record)
+
+    if engine == "stack":
+        with ThreadPoolExecutor(max(1, parallel)) as threads:
+            futures = {threads.submit(run_job, job, **options): job for job in job_list}
+            for future in as_completed(futures):
+                done(futures[future], future.result())
+        return records
+    context = multiprocessing.get_context("forkserver" if sys.platform != "win32" else "spawn")
+    pool = ProcessPoolExecutor(max(1, parallel), mp_context=context, initializer=_worker_start)
+    try:
+        futures = {pool.submit(run_job, job, **options): job for job in job_list}
         for future in as_completed(futures):
-            job = futures[future]
-            record = future.result()
-            records[job.key] = record
-            if on_done is not None:
-                on_done(job, record)
+            done(futures[future], future.result())
+    except BaseException:
+        stop_workers(pool)  # Ctrl-C or a failed job: no worker outlives the batch
+        raise
+    pool.shutdown(wait=True)
+    if verify > 0:
+        say = echo or (lambda text: print(text, file=sys.stderr))
+        chosen = sample(job_list, verify, verify_seed)
+        records.verified, records.disagreements = verify_with_stack(
+            chosen, records, parallel, log_level="WARNING")
+        if records.disagreements:
+            say("!" * 72)
+            say(f"ENGINES DISAGREE on {len(records.disagreements)} of "
+                f"{len(records.verified)} runs re-made through the stack:")
+            for line in records.disagreements:
+                say(f"  {line}")
+            say("!" * 72)
+        else:
+            say(f"verified: {len(records.verified)} runs re-made through the stack agree "
+                f"tick by tick ({', '.join(records.verified)})")
     return records

@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from zenav.batch import Job, run_batch
+from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch
+from zenav.engine import ENGINES
 from zenav.services.mission import window_radius
 from zenav.sim import SCENARIO_DIR
 from zenav.sim.scenario import Scenario, load_scenario
@@ -319,25 +320,36 @@ def machine_description() -> str:
 
 
 def main(out: Path, quick: bool = False, parallel: int = 2,
-         profiles: tuple[str, ...] = PROFILES, reuse: bool = False) -> Path:
+         profiles: tuple[str, ...] = PROFILES, reuse: bool = False, engine: str = "stack",
+         verify: int = DEFAULT_VERIFY) -> Path:
     """Run the experiments with a progress bar, draw the figures, write the report.
     ``reuse``: a run whose ``run.json`` is already in ``out`` is not run again."""
     import time
 
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     started = time.monotonic()
     jobs = plan_jobs(out, quick, profiles)
     with Progress(TextColumn("[bold]zenav paper"), BarColumn(), TextColumn("{task.completed}/"
                   "{task.total} runs"), TextColumn("{task.description}"),
-                  TimeElapsedColumn()) as progress:
+                  TimeElapsedColumn(), TimeRemainingColumn()) as progress:
         task = progress.add_task("", total=len(jobs) + 2)
+        finished: list[bool] = []
 
         def done(job: Job, record: dict[str, Any]) -> None:
-            progress.update(task, advance=1, description=job.key)
+            finished.append(record["outcome"] == "reached")
+            progress.update(task, advance=1, description=f"{sum(finished)}/{len(finished)} "
+                            f"reached; {job.key}")
 
         # keep_going: a run that fails is a result of the report, not the end of it
-        records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse)
+        records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse, engine=engine,
+                            verify=verify)
         progress.update(task, description="figures")
         make_figures(out, jobs, records)
         progress.update(task, advance=1, description="typing accuracy")
@@ -353,7 +365,7 @@ def _command(args: argparse.Namespace) -> int:
     profiles = PROFILES if args.profile == "both" else (args.profile,)
     try:
         report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
-                      reuse=args.reuse)
+                      reuse=args.reuse, engine=args.engine, verify=args.verify)
     except RunError as exc:
         print(f"zenav paper: {exc}", file=sys.stderr)
         return 1
@@ -366,11 +378,18 @@ def add_command(sub: Any) -> None:
     paper.add_argument("--out", type=Path, default=Path("out/paper"), help="report directory")
     paper.add_argument("--quick", action="store_true",
                        help="scenario (a) once per profile only (a smoke test of the report)")
-    paper.add_argument("--parallel", type=int, default=2, help="runs at once (default 2)")
+    paper.add_argument("--jobs", "--parallel", dest="parallel", type=int,
+                       default=default_jobs(), help="runs at once (default: the cores)")
     paper.add_argument("--profile", choices=("both", *PROFILES), default="both",
                        help="parameter profile(s) to run: both (default, side by side), "
                             "zenav or paper")
     paper.add_argument("--reuse", action="store_true",
                        help="take a run.json already under --out as that run's record "
                             "(finish or redraw an interrupted report)")
+    paper.add_argument("--engine", choices=ENGINES, default="stack",
+                       help="stack (default): six processes over Zenoh per run; inprocess: "
+                       "the same services in one process per run, worker processes in parallel")
+    paper.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
+                       help="with --engine inprocess: runs re-made through the stack and "
+                       f"compared tick by tick (default {DEFAULT_VERIFY})")
     paper.set_defaults(func=_command)

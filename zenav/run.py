@@ -160,12 +160,14 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
                                f"another arriving; still waiting on {missing}")
             with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(everyone.wait(), timeout=0.1)
-        token = bus.declare_token(k.alive("run"))
+        # Subscribed before the run is announced: the first events come at once, and
+        # the history query alone can miss them when it times out on a loaded machine.
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
         odom = bus.subscribe(k.of(keys.ODOM), depth=1)
         paths = bus.subscribe(k.of(keys.PATH), depth=1)
         maps = bus.subscribe(k.of(keys.MAP), depth=1)
+        token = bus.declare_token(k.alive("run"))
         events: list[PlannerEvent] = []
         last_progress = time.monotonic()
         sim_time = -1.0
@@ -252,18 +254,28 @@ def run_scenario(
     robot_face: str = "native",
     mcap: bool = False,
     profile: str = DEFAULT_PROFILE,
+    engine: str = "stack",
 ) -> dict[str, Any]:
-    """Run one scenario through the full stack; write run.json and run.png; the record.
+    """Run one scenario; write run.json and run.png; the record.
 
-    ``robot_face="ros2"``: the simulated robot is a ROS 2 robot over rmw_zenoh, reached
-    through the ros2 backends of the laser driver and motor bridge. ``mcap``: also
-    ``run.mcap``, every message of the run, openable in Foxglove. ``profile``: the named
-    set of parameter overrides (``zenav.services.profiles``) laid over the defaults,
-    under the scenario's values and ``overrides``."""
+    ``engine``: ``stack`` (the default and the acceptance path) runs the six service
+    processes over Zenoh; ``inprocess`` runs the same services in this process on an
+    in-memory bus (:mod:`zenav.engine`), with the same record.
+    ``robot_face="ros2"`` (stack only): the simulated robot is a ROS 2 robot over
+    rmw_zenoh, reached through the ros2 backends of the laser driver and motor bridge.
+    ``mcap`` (stack only): also ``run.mcap``, every message of the run, openable in
+    Foxglove.
+    ``profile``: the named set of parameter overrides (``zenav.services.profiles``) laid
+    over the defaults, under the scenario's values and ``overrides``."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
         raise ConfigError(f"--planner {planner!r}: no such planner; choose from "
                           f"{', '.join(PLANNERS)}")
+    if engine not in ("stack", "inprocess"):
+        raise ConfigError(f"--engine {engine!r}: choose one of stack, inprocess")
+    if engine == "inprocess" and (robot_face != "native" or mcap):
+        raise ConfigError("--engine inprocess runs the native robot without recording; "
+                          "--robot ros2 and --record need --engine stack")
     params = stack_params(scenario, scenario_path, planner)
     apply_profile(params, profile, planner)  # raises ConfigError for an unknown profile
     if robot_face not in ROBOT_FACES:
@@ -274,15 +286,27 @@ def run_scenario(
     for text in overrides or []:
         apply_override(params, text)
     out_dir.mkdir(parents=True, exist_ok=True)
-    stack = Stack(out_dir=out_dir, params=params, log_level=log_level, planner=planner)
     started = time.monotonic()
-    stack.start()
-    try:
-        heard = Heard()
-        result, events = asyncio.run(_collect(stack, progress_timeout,
-                                              out_dir / "run.mcap" if mcap else None, heard))
-    finally:
-        codes = stack.stop()
+    codes: dict[str, int] = {}
+    heard = Heard()
+    if engine == "inprocess":
+        from zenav.engine import EngineError, run_services
+
+        try:
+            ran = run_services(params, planner, log_path=out_dir / "logs" / "engine.log",
+                               log_level=log_level)
+        except (EngineError, ConfigError) as exc:
+            raise RunError(str(exc)) from None
+        result, events = ran.result, ran.events
+        heard.path, heard.occupancy = ran.path, ran.occupancy
+    else:
+        stack = Stack(out_dir=out_dir, params=params, log_level=log_level, planner=planner)
+        stack.start()
+        try:
+            result, events = asyncio.run(_collect(stack, progress_timeout,
+                                                  out_dir / "run.mcap" if mcap else None, heard))
+        finally:
+            codes = stack.stop()
     record = make_record(result, events, planner)
     record["wall_time"] = round(time.monotonic() - started, 3)
     record["seed"] = scenario.seed
@@ -291,6 +315,8 @@ def run_scenario(
     if heard.path is not None:  # optional field: the last global path, [[x, y], ...]
         record["path"] = [[round(float(x), 4), round(float(y), 4)]
                           for x, y in heard.path.points]
+    if engine != "stack":
+        record["engine"] = engine
     unclean = {name: code for name, code in codes.items() if code != 0}
     if unclean:
         record["unclean_exits"] = unclean

@@ -24,7 +24,7 @@ def _run(args: argparse.Namespace) -> int:
         record = run_scenario(args.scenario, args.out, planner=args.planner,
                               overrides=args.set, log_level=args.log_level,
                               robot_face=args.robot, mcap=args.record,
-                              profile=args.profile)
+                              profile=args.profile, engine=args.engine)
     except (ScenarioError, ConfigError, PathError) as exc:
         say_each("zenav run", exc)
         return 2
@@ -93,6 +93,9 @@ def add_commands(sub: Any) -> None:
     run.add_argument("--record", action="store_true",
                      help="also write DIR/run.mcap: every message of the run, with Foxglove "
                           "channels (opens in Foxglove)")
+    run.add_argument("--engine", choices=("stack", "inprocess"), default="stack",
+                     help="stack: six processes over Zenoh (default, the acceptance path); "
+                          "inprocess: the same services in one process on an in-memory bus")
     run.set_defaults(func=_run)
 
     service = sub.add_parser("service", help="run one service process",

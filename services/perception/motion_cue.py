@@ -75,12 +75,16 @@ def motion_scores(
     past_beams: IntArray,
     margin: float,
     reach: float,
+    window_points: FloatArray | None = None,
+    past_points: FloatArray | None = None,
 ) -> FloatArray:
     """(n,) score in [0, 1] per cluster: how much of it moved since ``past``.
 
     ``cluster_beams`` (n, 2) first/last beam of each cluster; ``window_beams`` the
     current scan's beams inside the window; ``past_beams`` the same for ``past``.
     ``reach`` m: how far from a cluster's points earlier points count as its own.
+    ``window_points`` and ``past_points``: the global points of ``window_beams`` and
+    ``past_beams`` when the caller has them already (:class:`MotionCue` keeps them).
     """
     n = len(cluster_beams)
     scores = np.zeros(n)
@@ -90,21 +94,28 @@ def motion_scores(
     owner = np.full(current.ranges.shape[0], -1, dtype=np.int64)
     for k, (first, last) in enumerate(cluster_beams):
         owner[first: last + 1] = k
-    beams = window_beams[owner[window_beams] >= 0]
+    owned = owner[window_beams] >= 0
+    beams = window_beams[owned]
     if len(beams) == 0:
         return scores
     member = owner[beams]
-    points = current.points(beams)
+    points = (current.points(beams) if window_points is None else window_points[owned])
     counts = np.bincount(member, minlength=n)
     entered = np.bincount(member, weights=seen_free(past, points, margin), minlength=n)
     scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
     if len(past_beams) >= 2:
-        past_points = past.points(past_beams)
+        if past_points is None:
+            past_points = past.points(past_beams)
         vacated = seen_free(current, past_points, margin)
         lo = np.full((n, 2), np.inf)
         hi = np.full((n, 2), -np.inf)
-        np.minimum.at(lo, member, points)
-        np.maximum.at(hi, member, points)
+        # Each cluster's bounding box: its points grouped by cluster, then one min and
+        # one max per group (exact, as np.minimum.at would give, without its slow path).
+        order = np.argsort(member, kind="stable")
+        grouped, ordered = member[order], points[order]
+        starts = np.flatnonzero(np.r_[True, grouped[1:] != grouped[:-1]])
+        lo[grouped[starts]] = np.minimum.reduceat(ordered, starts, axis=0)
+        hi[grouped[starts]] = np.maximum.reduceat(ordered, starts, axis=0)
         lo -= reach
         hi += reach
         near = np.all((past_points[:, None, :] >= lo[None]) & (past_points[:, None, :] <= hi[None]),
@@ -125,7 +136,7 @@ class MotionCue:
         self.margin = margin
         self.reach = reach
         self.window_radius = window_radius
-        self._scans: list[tuple[ScanSnapshot, IntArray]] = []
+        self._scans: list[tuple[ScanSnapshot, IntArray, FloatArray]] = []
 
     def _window(self, scan: ScanSnapshot, range_min: float) -> IntArray:
         r = scan.ranges
@@ -146,6 +157,7 @@ class MotionCue:
         comparisons with scans taken before: an obstacle that appeared out of nothing
         occupies space those scans saw empty without having moved."""
         window = self._window(scan, range_min)
+        points = scan.points(window)  # once per scan, kept for the scans after it
         scores = np.zeros((len(cluster_beams), len(self.baselines)))
         stamps = np.full(len(self.baselines), np.nan)
         for j, baseline in enumerate(self.baselines):
@@ -153,14 +165,15 @@ class MotionCue:
             if past is not None:
                 stamps[j] = past[0].stamp
                 scores[:, j] = motion_scores(scan, cluster_beams, window, past[0], past[1],
-                                             self.margin, self.reach)
-        self._scans.append((scan, window))
+                                             self.margin, self.reach, window_points=points,
+                                             past_points=past[2])
+        self._scans.append((scan, window, points))
         oldest = scan.stamp - self.baselines[-1] - 1.0
         while len(self._scans) > 1 and self._scans[1][0].stamp <= oldest:
             self._scans.pop(0)
         return scores, stamps
 
-    def _at_least(self, stamp: float) -> tuple[ScanSnapshot, IntArray] | None:
+    def _at_least(self, stamp: float) -> tuple[ScanSnapshot, IntArray, FloatArray] | None:
         """The newest remembered scan taken at or before ``stamp``."""
         found = None
         for entry in self._scans:

@@ -49,7 +49,7 @@ from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import (
     Assessment,
     Obstacle,
-    assess,
+    assess_all,
     cell_squares,
     gap_to_boxes,
     path_points,
@@ -246,21 +246,16 @@ class Planner:
             length = max(distance, min(self._straight_ahead(robot, direction),
                                        self.p.window_radius))
         p = self.p
-        found = []
-        for ob in obstacles:
-            margin = p.safety_margin + extra_margin
-            if ob.id in self.commitments and ob.kind == "dynamic":
-                margin += p.threat_hysteresis
-            committed = self.commitments.get(ob.id)
-            horizon = p.horizon * (1.25 if committed is not None else 1.0)
-            a = assess(robot, direction, p.cruise_speed, length, ob, robot_radius=p.robot_radius,
-                       margin=margin, cell=p.cell, horizon=horizon,
-                       moving_speed=p.moving_speed, head_on_cos=p.head_on_cos,
-                       same_way_cos=p.same_way_cos,
-                       following=committed is not None and committed.letter == "g")
-            if a is not None:
-                found.append(a)
-        return found
+        held = [self.commitments.get(ob.id) for ob in obstacles]
+        return assess_all(
+            robot, direction, p.cruise_speed, length, obstacles,
+            margins=[p.safety_margin + extra_margin
+                     + (p.threat_hysteresis if c is not None and ob.kind == "dynamic" else 0.0)
+                     for ob, c in zip(obstacles, held, strict=True)],
+            horizons=[p.horizon * (1.25 if c is not None else 1.0) for c in held],
+            following=[c is not None and c.letter == "g" for c in held],
+            robot_radius=p.robot_radius, cell=p.cell, moving_speed=p.moving_speed,
+            head_on_cos=p.head_on_cos, same_way_cos=p.same_way_cos)
 
     def _straight_ahead(self, robot: Vec, direction: Vec) -> float:
         """How far the global path runs on from the robot in ``direction`` before it

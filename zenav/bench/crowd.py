@@ -80,8 +80,16 @@ def stack_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone) -> dict[st
                      keep_going=True)
 
 
-ENGINES: dict[str, Engine] = {"stack": stack_engine}
-"""Engines by name; the in-process engine (issue 13) registers itself here."""
+def inprocess_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone) -> dict[str, Record]:
+    """Every job with the in-process engine (``zenav run --engine inprocess``) in worker
+    processes; a seeded sample is then re-made through the stack and compared tick by
+    tick (:func:`zenav.batch.run_batch`)."""
+    return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=True,
+                     keep_going=True, engine="inprocess", picture=False)
+
+
+ENGINES: dict[str, Engine] = {"stack": stack_engine, "inprocess": inprocess_engine}
+"""Engines by name."""
 
 
 def discomfort_steps(record: Record, robot_radius: float = ROBOT_RADIUS,

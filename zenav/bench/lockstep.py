@@ -81,3 +81,56 @@ def lockstep_table(rows: list[LockstepRow]) -> str:
                  f"in the simulator's loop, {sim / wall:.1f}× for the whole command with the "
                  f"processes' start and stop ({verdict(factor >= TARGET_LOCKSTEP_FACTOR)}).")
     return "\n".join(lines)
+
+
+TARGET_ENGINE_FACTOR = 300.0
+TARGET_COMMAND_FACTOR = 30.0
+
+
+@dataclass
+class EngineRow:
+    scenario: str
+    outcome: str
+    sim_time: float
+    wall: float
+    cpu: float  # this process's CPU seconds for the run
+
+
+def measure_engine(work: Path, scenarios: tuple[Path, ...] = PAPER_SCENARIOS,
+                   planner: str = "paper") -> list[EngineRow]:
+    """The in-process engine (``zenav run --engine inprocess``, without the picture) on
+    each scenario in this process, once the modules are imported: simulated s and wall s."""
+    import time
+
+    from zenav.run import run_scenario
+
+    rows = []
+    for path in scenarios:
+        started, cpu = time.perf_counter(), time.process_time()
+        record = run_scenario(path, work / "engine" / path.stem, planner=planner,
+                              picture=False, engine="inprocess", log_level="WARNING")
+        rows.append(EngineRow(path.stem, record["outcome"], record["time"],
+                              time.perf_counter() - started, time.process_time() - cpu))
+    return rows
+
+
+def engine_factor(rows: list[EngineRow], cpu: bool = False) -> float:
+    """Simulated seconds per wall second (``cpu``: per CPU second of this process)."""
+    return sum(r.sim_time for r in rows) / sum(r.cpu if cpu else r.wall for r in rows)
+
+
+def engine_table(rows: list[EngineRow]) -> str:
+    lines = ["| scenario | outcome | simulated s | wall s | × real time (wall) | CPU s | "
+             "× real time (CPU) |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r.scenario} | {r.outcome} | {r.sim_time:.1f} | {r.wall:.2f} | "
+                     f"{r.sim_time / r.wall:.1f} | {r.cpu:.2f} | {r.sim_time / r.cpu:.1f} |")
+    sim = sum(r.sim_time for r in rows)
+    factor, per_cpu = engine_factor(rows), engine_factor(rows, cpu=True)
+    lines.append(f"| **all** | | {sim:.1f} | {sum(r.wall for r in rows):.2f} | "
+                 f"**{factor:.1f}** | {sum(r.cpu for r in rows):.2f} | **{per_cpu:.1f}** |")
+    lines.append("")
+    lines.append(f"Target: ≥ {TARGET_ENGINE_FACTOR:g}× real time — measured {factor:.1f}× in "
+                 f"wall time, {per_cpu:.1f}× per CPU second of the process "
+                 f"({verdict(factor >= TARGET_ENGINE_FACTOR)}).")
+    return "\n".join(lines)

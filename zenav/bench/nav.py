@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import statistics
 import sys
 from collections.abc import Callable, Sequence
@@ -24,8 +23,9 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from zenav.batch import Job, run_batch
+from zenav.batch import DEFAULT_VERIFY, Job, Records, default_jobs, run_batch
 from zenav.bench.common import machine, words
+from zenav.engine import ENGINES
 from zenav.sim.generate import FAMILIES, random_scenario
 from zenav.sim.scenario import dump_scenario
 
@@ -180,9 +180,20 @@ def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
     draw_bench_chart(planners, outcomes, success, path)
 
 
+def verified_note(batch: Records) -> str:
+    """What the stack said of the in-process runs it re-made, for the report."""
+    if not batch.verified:
+        return ""
+    if batch.disagreements:
+        return (f"; {len(batch.disagreements)} of {len(batch.verified)} runs re-made through "
+                f"the stack DISAGREE")
+    return f"; {len(batch.verified)} runs re-made through the stack agree tick by tick"
+
+
 def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             families: Sequence[str] = FAMILIES, jobs: int = 2,
-            progress: bool = True, echo: Callable[[str], None] = print) -> str:
+            progress: bool = True, echo: Callable[[str], None] = print,
+            engine: str = "inprocess", verify: int = DEFAULT_VERIFY) -> str:
     """Write the worlds, run every planner on each, print and write the report."""
     from rich.progress import (
         BarColumn,
@@ -214,10 +225,13 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
 
         def done(job: Job, record: dict[str, Any]) -> None:
             records.append(record)
-            bar.update(task, advance=1, description=f"{job.planner} {job.name}: "
-                       f"{record['outcome']}")
+            reached = sum(r["outcome"] == "reached" for r in records)
+            bar.update(task, advance=1, description=f"{reached}/{len(records)} reached; "
+                       f"{job.planner} {job.name}: {record['outcome']}")
 
-        run_batch(job_list, jobs, done, log_level="WARNING", reuse=True, keep_going=True)
+        batch = run_batch(job_list, jobs, done, log_level="WARNING", reuse=True,
+                          keep_going=True, engine=engine, verify=verify,
+                          picture=engine == "stack", echo=echo)
     for r in records:
         if r["outcome"] == "error":
             echo(f"run failed: {r['planner']} {r['scenario']}: {r.get('error')}")
@@ -228,7 +242,8 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     report = (f"# zenav bench nav\n\n`{command}`\n\n"
               f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
               f"{len(paths)} worlds ({worlds} per family: {', '.join(families)}), "
-              f"{jobs} runs at a time\n\n{tables(summaries, per_family)}\n\n"
+              f"{jobs} runs at a time ({engine} engine{verified_note(batch)})\n\n"
+              f"{tables(summaries, per_family)}\n\n"
               f"{goal_lines(summaries, per_family)}\n")
     (out / "nav.md").write_text(report)
     (out / "nav.json").write_text(json.dumps(
@@ -243,7 +258,7 @@ def _command(args: argparse.Namespace) -> int:
     try:
         run_nav(words(args.planners), args.worlds, args.seed, args.out,
                 families=words(args.families), jobs=args.jobs,
-                progress=not args.no_progress)
+                progress=not args.no_progress, engine=args.engine, verify=args.verify)
     except ValueError as exc:
         print(f"zenav bench nav: {exc}", file=sys.stderr)
         return 2
@@ -259,9 +274,14 @@ def add_command(kinds: Any) -> None:
     nav.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     nav.add_argument("--families", default=",".join(FAMILIES),
                      help=f"comma-separated world families (default {','.join(FAMILIES)})")
-    nav.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                     help="runs at a time (default: the number of cores; each run is six "
-                     "processes)")
+    nav.add_argument("--jobs", type=int, default=default_jobs(),
+                     help="runs at a time (default: the number of cores)")
+    nav.add_argument("--engine", choices=ENGINES, default="inprocess",
+                     help="inprocess (default): the services in one process per run, "
+                     "worker processes in parallel; stack: six processes over Zenoh per run")
+    nav.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
+                     help=f"in-process runs re-made through the stack and compared tick by "
+                     f"tick (default {DEFAULT_VERIFY})")
     nav.add_argument("--out", type=Path, default=Path("out/bench-nav"),
                      help="directory for the worlds, runs, nav.md, nav.png, nav.json")
     nav.add_argument("--no-progress", action="store_true", help="no progress bar")

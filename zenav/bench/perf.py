@@ -1,9 +1,10 @@
-"""``zenav bench perf``: compute per scan, latency over Zenoh, lockstep speed, sustained
-scan rate and memory of the service stack.
+"""``zenav bench perf``: compute per scan, latency over Zenoh, lockstep speed, the
+in-process engine's speed, sustained scan rate and memory of the service stack.
 
-Five measurements (one module each: :mod:`.compute`, :mod:`.latency`, :mod:`.memory`,
+Six measurements (one module each: :mod:`.compute`, :mod:`.latency`, :mod:`.memory`,
 :mod:`.lockstep`, :mod:`.rate`), each printed as a Markdown table with the issue's target beside the
-measured figure (targets are reported, never asserted):
+measured figure (targets are reported, never asserted), and at the end one summary table
+of every target measured in this run:
 
 - **compute**: the pure cores timed in one process on simulated 361-beam scans with 0,
   5 and 20 obstacles in view, the robot standing, one box on its path and half the
@@ -17,6 +18,8 @@ measured figure (targets are reported, never asserted):
   the motor bridge's publish, both seen one hop away;
 - **lockstep**: ``zenav run`` on the eight paper scenarios, simulated seconds per wall
   second of the simulator's loop (from its log) and of the whole command;
+- **engine**: ``zenav run --engine inprocess`` on the same scenarios, simulated seconds
+  per wall second (the six services in this process, modules already imported);
 - **rate**: the real-time simulator with the laser rate raised; the highest rate at which
   no service drops an input (the ``status/<service>`` counters) and every scan gets its
   base command;
@@ -26,6 +29,8 @@ measured figure (targets are reported, never asserted):
 from __future__ import annotations
 
 import argparse
+import math
+import statistics
 import sys
 import tempfile
 from collections.abc import Callable
@@ -33,14 +38,36 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from zenav.bench.common import machine, words
-from zenav.bench.compute import compute_table, time_compute
-from zenav.bench.latency import latency_table, measure_latency
-from zenav.bench.lockstep import lockstep_table, measure_lockstep
+from zenav.bench.common import machine, percentile, verdict, words
+from zenav.bench.compute import TARGET_PIPELINE_MEDIAN_US, compute_table, time_compute
+from zenav.bench.latency import (
+    TARGET_LATENCY_MEDIAN_MS,
+    TARGET_LATENCY_P99_MS,
+    latency_table,
+    measure_latency,
+)
+from zenav.bench.lockstep import (
+    TARGET_COMMAND_FACTOR,
+    TARGET_ENGINE_FACTOR,
+    TARGET_LOCKSTEP_FACTOR,
+    engine_factor,
+    engine_table,
+    lockstep_table,
+    measure_engine,
+    measure_lockstep,
+)
 from zenav.bench.memory import memory_table
 from zenav.bench.rate import measure_rate, rate_table
 
-SECTIONS = ("compute", "latency", "lockstep", "rate")
+SECTIONS = ("compute", "latency", "lockstep", "engine", "rate")
+
+
+def summary_table(figures: dict[str, tuple[str, str, bool]]) -> str:
+    """The issue's table: each measure that was run, its figure and target side by side."""
+    lines = ["| measure | measured | target | |", "|---|---|---|---|"]
+    for name, (measured, target, met) in figures.items():
+        lines.append(f"| {name} | {measured} | {target} | {verdict(met)} |")
+    return "\n".join(lines)
 
 def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
              obstacle_counts: tuple[int, ...] = (0, 5, 20), latency_seconds: float = 30.0,
@@ -50,23 +77,59 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
     parts = [f"# zenav bench perf\n\n{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, "
              f"{machine()}, Python {sys.version.split()[0]}\n"]
     echo(parts[0])
+    figures: dict[str, tuple[str, str, bool]] = {}
     with tempfile.TemporaryDirectory(prefix="zenav-bench-") as tmp:
         work = out if out is not None else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         for section in sections:
             if section == "compute":
                 results = [time_compute(n, scans) for n in obstacle_counts]
+                for r in results:
+                    if r.obstacles in (5, 20) and r.micros["pipeline"]:
+                        values = r.micros["pipeline"]
+                        median = statistics.median(values)
+                        goal = TARGET_PIPELINE_MEDIAN_US if r.obstacles == 5 else 1000.0
+                        figures[f"per-scan pipeline, {r.obstacles} obstacles, median / p99"] = (
+                            f"{median:.0f} / {percentile(values, 99):.0f} µs",
+                            f"≤ {goal:.0f} µs median", median <= goal)
                 text = ("## Compute per scan, in process (361 beams)\n\n"
                         + compute_table(results))
             elif section == "latency":
                 lat = measure_latency(latency_seconds, work)
+                if lat.scan_to_base_ms:
+                    med = statistics.median(lat.scan_to_base_ms)
+                    p99 = percentile(lat.scan_to_base_ms, 99)
+                    figures["scan → base command over Zenoh at 10 Hz, median / p99"] = (
+                        f"{med:.1f} / {p99:.1f} ms", f"≤ {TARGET_LATENCY_MEDIAN_MS:g} / "
+                        f"{TARGET_LATENCY_P99_MS:g} ms",
+                        med <= TARGET_LATENCY_MEDIAN_MS and p99 <= TARGET_LATENCY_P99_MS)
                 text = (f"## Scan-to-command latency over Zenoh (real time, 10 Hz, "
                         f"h-mixed, {latency_seconds:g} s)\n\n{latency_table(lat)}\n\n"
                         f"## Resident memory per service process (during that run)\n\n"
                         f"{memory_table(lat)}")
             elif section == "lockstep":
+                steps = measure_lockstep(work)
+                sim = sum(r.sim_time for r in steps)
+                loop = sum(r.loop_wall or math.nan for r in steps)
+                whole = sum(r.command_wall for r in steps)
+                figures["lockstep, simulator loop (stack)"] = (
+                    f"{sim / loop:.1f}× real time", f"≥ {TARGET_LOCKSTEP_FACTOR:g}×",
+                    sim / loop >= TARGET_LOCKSTEP_FACTOR)
+                figures["lockstep, whole `zenav run` command (stack)"] = (
+                    f"{sim / whole:.1f}× real time", f"≥ {TARGET_COMMAND_FACTOR:g}×",
+                    sim / whole >= TARGET_COMMAND_FACTOR)
                 text = ("## Lockstep simulation speed (zenav run, paper planner)\n\n"
-                        + lockstep_table(measure_lockstep(work)))
+                        + lockstep_table(steps))
+            elif section == "engine":
+                engine_rows = measure_engine(work)
+                factor = engine_factor(engine_rows)
+                figures["in-process engine, paper scenarios"] = (
+                    f"{factor:.1f}× real time "
+                    f"({engine_factor(engine_rows, cpu=True):.1f}× per CPU s)",
+                    f"≥ {TARGET_ENGINE_FACTOR:g}×", factor >= TARGET_ENGINE_FACTOR)
+                text = ("## In-process engine speed (zenav run --engine inprocess, paper "
+                        "planner, eight paper scenarios, one process)\n\n"
+                        + engine_table(engine_rows))
             elif section == "rate":
                 rows = []
                 for rate in rates:
@@ -77,6 +140,10 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
                 raise ValueError(f"unknown section {section!r}; choose from {', '.join(SECTIONS)}")
             parts.append(text)
             echo(text + "\n")
+    if figures:
+        text = "## Summary: the targets of issue 13\n\n" + summary_table(figures)
+        parts.append(text)
+        echo(text + "\n")
     report = "\n\n".join(parts) + "\n"
     if out is not None:
         (out / "perf.md").write_text(report)
@@ -101,8 +168,9 @@ def add_command(kinds: Any) -> None:
     """``zenav bench perf`` (``kinds``: the subcommands of ``zenav bench``)."""
     perf = kinds.add_parser("perf", help="compute per scan, latency, lockstep speed, "
                             "sustained rate, memory")
-    perf.add_argument("--sections", default="compute,latency,lockstep,rate",
-                      help="comma-separated: compute, latency (and memory), lockstep, rate")
+    perf.add_argument("--sections", default="compute,latency,lockstep,engine,rate",
+                      help="comma-separated: compute, latency (and memory), lockstep, "
+                      "engine (the in-process engine's speed), rate")
     perf.add_argument("--scans", type=int, default=200, help="scans timed per world (compute)")
     perf.add_argument("--obstacles", default="0,5,20", help="obstacles in view (compute)")
     perf.add_argument("--latency-seconds", type=float, default=30.0,
