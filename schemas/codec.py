@@ -93,10 +93,12 @@ def peek_stamp(payload: bytes) -> tuple[float | None, int | None]:
     if not isinstance(fields, dict):
         return None, None
     stamp, seq = fields.get("stamp"), fields.get("seq")
-    good_stamp = (isinstance(stamp, (int, float)) and not isinstance(stamp, bool)
-                  and math.isfinite(stamp) and stamp >= 0)
+    peeked: float | None = None
+    if isinstance(stamp, (int, float)) and not isinstance(stamp, bool):
+        value = float(stamp)
+        peeked = value if math.isfinite(value) and value >= 0 else None
     good_seq = isinstance(seq, int) and not isinstance(seq, bool) and seq >= 0
-    return (float(stamp) if good_stamp else None), (seq if good_seq else None)
+    return peeked, (seq if good_seq else None)
 
 
 def _summarise(exc: ValidationError) -> str:
