@@ -25,7 +25,13 @@ from zenav.services.ros2.view import path_to_ros, tracks_to_markers
 from zenav.services.ros2.wire import MARKER_ARRAY, PATH, WireError, qualify
 from zenav.services.runner import add_transport_arguments
 from zenav.services.transport import Bus
-from zenav.tooling import ConnectError, add_connect_timeout, open_bus, stop_on_signals, tool_setup
+from zenav.tooling import (
+    add_connect_timeout,
+    open_bus,
+    run_tool,
+    stop_on_signals,
+    tool_setup,
+)
 
 
 class RvizView:
@@ -124,13 +130,7 @@ def main(args: argparse.Namespace) -> int:
             print(f"zenav rviz: {option}: {exc}", file=sys.stderr)
             return 2
     robot_id, transport = setup
-    try:
-        with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(serve(transport, robot_id, args))
-    except ConnectError as exc:
-        print(f"zenav rviz: {exc}", file=sys.stderr)
-        return 1
-    return 0
+    return run_tool("rviz", serve(transport, robot_id, args))
 
 
 def add_command(sub: Any) -> None:

@@ -16,7 +16,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 from zenav.services.runner import transport_from_args
@@ -185,6 +185,21 @@ def tool_setup(args: argparse.Namespace, command: str) -> tuple[str, TransportCo
     except (ConfigError, ValueError) as exc:
         print(f"zenav {command}: {exc}", file=sys.stderr)
         return None
+
+
+def run_tool(command: str, main: Coroutine[Any, Any, None],
+             failures: tuple[type[Exception], ...] = ()) -> int:
+    """Run a tool's main coroutine to the end: 0 when it finishes or Ctrl-C stops it, 1 with
+    one line ``zenav COMMAND: reason`` when the router cannot be reached or one of
+    ``failures`` (the tool's own ways to fail at start, e.g. a port in use) is raised."""
+    expected: tuple[type[Exception], ...] = (ConnectError, *failures)
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            asyncio.run(main)
+    except expected as exc:
+        print(f"zenav {command}: {exc}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def stop_on_signals(stop: asyncio.Event) -> None:

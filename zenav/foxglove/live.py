@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import sys
 from typing import Any
 
@@ -23,10 +22,10 @@ from zenav.foxglove.scene import TOPICS
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
     CONNECT_TIMEOUT,
-    ConnectError,
     StampedSubscriber,
     add_connect_timeout,
     open_bus,
+    run_tool,
     stop_on_signals,
     tool_setup,
 )
@@ -84,17 +83,9 @@ def main(args: argparse.Namespace) -> int:
         print(f"zenav foxglove: --port {args.port} is not a TCP port", file=sys.stderr)
         return 2
     robot_id, transport = setup
-    try:
-        with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(serve(transport, robot_id, args.host, args.port, args.duration,
-                              args.connect_timeout))
-    except ConnectError as exc:  # before RuntimeError, of which it is a subclass
-        print(f"zenav foxglove: {exc}", file=sys.stderr)
-        return 1
-    except RuntimeError as exc:  # the SDK's server could not bind
-        print(f"zenav foxglove: {exc}", file=sys.stderr)
-        return 1
-    return 0
+    # RuntimeError: the SDK's server could not bind its port
+    return run_tool("foxglove", serve(transport, robot_id, args.host, args.port, args.duration,
+                                      args.connect_timeout), failures=(RuntimeError,))
 
 
 def add_command(sub: Any) -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import json
 import sys
 import time
@@ -16,10 +15,10 @@ from zenav.monitor.screen import render
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
     CONNECT_TIMEOUT,
-    ConnectError,
     StampedSubscriber,
     add_connect_timeout,
     open_bus,
+    run_tool,
     stop_on_signals,
     tool_setup,
     wait_for_event,
@@ -74,15 +73,9 @@ def main(args: argparse.Namespace) -> int:
     if setup is None:
         return 2
     robot_id, transport = setup
-    try:
-        with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
-                                duration=args.duration, silence=args.silence,
-                                connect_timeout=args.connect_timeout))
-    except ConnectError as exc:
-        print(f"zenav monitor: {exc}", file=sys.stderr)
-        return 1
-    return 0
+    return run_tool("monitor", monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
+                                       duration=args.duration, silence=args.silence,
+                                       connect_timeout=args.connect_timeout))
 
 
 def add_command(sub: Any) -> None:
