@@ -51,15 +51,18 @@ FUZZED: tuple[Topic, ...] = (keys.RAW_LASER, keys.BASE_CMD, keys.SCAN, keys.ODOM
                              keys.OBSTACLES, keys.TRACKS, keys.CMD_VEL)
 """Every key a service subscribes to."""
 
-SUBSCRIBERS: dict[str, tuple[str, ...]] = {
-    keys.RAW_LASER.name: ("laser_driver",),
-    keys.BASE_CMD.name: ("simulator",),
-    keys.SCAN.name: ("perception", "motor_bridge"),
-    keys.ODOM.name: ("perception", "motor_bridge"),
-    keys.OBSTACLES.name: ("tracking",),
-    keys.TRACKS.name: ("planner",),
-    keys.CMD_VEL.name: ("motor_bridge",),
-}
+def _subscribers() -> dict[str, tuple[str, ...]]:
+    """Which services read each fuzzed key, from the services' own code (the graph that
+    deploy/graph.yaml is checked against), so a new subscription is counted here too."""
+    from zenav.graph import derive_graph
+
+    services = derive_graph()["services"]
+    return {topic.name: tuple(name for name, entry in services.items()
+                              if topic.name in entry.get("subscribes", {}))
+            for topic in FUZZED}
+
+
+SUBSCRIBERS: dict[str, tuple[str, ...]] = _subscribers()
 
 FUTURE = 1.0e6
 """Stamp of the "future" messages: far beyond any run."""
