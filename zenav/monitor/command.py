@@ -26,7 +26,7 @@ from zenav.tooling import (
 
 
 async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
-                  duration: float | None, silence: float = 0.5,
+                  duration: float | None, silence: float = 0.5, scale: float = 0.25,
                   out: IO[str] = sys.stdout, connect_timeout: float = CONNECT_TIMEOUT) -> None:
     model = MonitorModel(robot_id, silence_after=silence)
     loop = asyncio.get_running_loop()
@@ -55,13 +55,13 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
         else:
             from rich.live import Live
 
-            with Live(render(model, time.time()), refresh_per_second=max(1, round(1 / period)),
-                      screen=False) as live:
+            with Live(render(model, time.time(), scale),
+                      refresh_per_second=max(1, round(1 / period)), screen=False) as live:
                 while not stop.is_set():
                     now = time.time()
                     model.tick(now)
                     model.drain_events()  # shown in "recent events"
-                    live.update(render(model, now))
+                    live.update(render(model, now, scale))
                     await wait_for_event(stop, period)
     finally:
         subscriber.close()
@@ -73,8 +73,13 @@ def main(args: argparse.Namespace) -> int:
     if setup is None:
         return 2
     robot_id, transport = setup
+    if not args.map_scale > 0:
+        print(f"zenav monitor: --map-scale must be above 0 m, not {args.map_scale:g}",
+              file=sys.stderr)
+        return 2
     return run_tool("monitor", monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
                                        duration=args.duration, silence=args.silence,
+                                       scale=args.map_scale,
                                        connect_timeout=args.connect_timeout))
 
 
@@ -82,7 +87,8 @@ def add_command(sub: Any) -> None:
     monitor = sub.add_parser(
         "monitor", help="live read-only view of a running stack",
         description="Live view: robot pose and speed, obstacles, the planner's scenario and "
-        "action, each service's liveliness, message rates, scan-to-command latency. "
+        "action, its global path and occupancy map (with a character map round the robot), "
+        "each service's liveliness, message rates, scan-to-command latency. "
         "--connect ENDPOINT joins a router as a client from any host.")
     monitor.add_argument("--jsonl", action="store_true",
                          help="print events and snapshots as JSON lines, not a screen")
@@ -92,6 +98,9 @@ def add_command(sub: Any) -> None:
     monitor.add_argument("--silence", type=float, default=0.5,
                          help="a topic silent this long (s, at least 4 typical gaps) counts "
                          "as stopped (default 0.5)")
+    monitor.add_argument("--map-scale", type=float, default=0.25, metavar="M",
+                         help="m of the world per column of the map view, rows twice that "
+                         "(default 0.25: 41 x 21 characters cover about 10 x 10 m)")
     add_transport_arguments(monitor)
     add_connect_timeout(monitor)
     monitor.set_defaults(func=main)

@@ -10,14 +10,19 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+import numpy.typing as npt
+
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys, Topic
 from zenav.schemas.messages import (
     BaseCommand,
+    GlobalPath,
     GroundTruth,
     LaserScan,
     Message,
+    OccupancyMap,
     Odometry,
     PlannerEvent,
     PlannerState,
@@ -119,6 +124,65 @@ class TopicState:
     count: int = 0
 
 
+def path_length(points: npt.NDArray[np.float64]) -> float:
+    """m along the vertices (0 for fewer than two)."""
+    if len(points) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(points, axis=0).T).sum())
+
+
+def along_path(points: npt.NDArray[np.float64], x: float, y: float) -> tuple[float, float]:
+    """(m still to go along the path from the point of it nearest (x, y), m from (x, y) to
+    that point). The path needs two vertices or more."""
+    a, b = points[:-1], points[1:]
+    d = b - a
+    seg = np.hypot(d[:, 0], d[:, 1])
+    q = np.array([x, y])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.where(seg > 0, ((q - a) * d).sum(axis=1) / np.maximum(seg, 1e-12) ** 2, 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    nearest = a + t[:, None] * d
+    gaps = np.hypot(*(nearest - q).T)
+    k = int(np.argmin(gaps))
+    to_go = float(seg[k] * (1.0 - t[k]) + seg[k + 1:].sum())
+    return to_go, float(gaps[k])
+
+
+@dataclass(frozen=True)
+class PathState:
+    """The planner's newest global path as the monitor heard it."""
+
+    message: GlobalPath
+    received: float  # wall time
+    length: float  # m
+    plans: int  # paths heard since the monitor started
+
+    @property
+    def found(self) -> bool:
+        return len(self.message.points) >= 2
+
+
+@dataclass(frozen=True)
+class MapState:
+    """The planner's newest occupancy map, with its cell counts (taken once, on receipt:
+    the grid can be millions of cells)."""
+
+    message: OccupancyMap
+    received: float  # wall time
+    known: int  # cells free or occupied
+    occupied: int
+
+    @classmethod
+    def of(cls, message: OccupancyMap, received: float) -> MapState:
+        cells = message.cells
+        return cls(message, received, known=int(np.count_nonzero(cells >= 0)),
+                   occupied=int(np.count_nonzero(cells > 50)))
+
+    @property
+    def cells(self) -> int:
+        return self.message.width * self.message.height
+
+
 @dataclass
 class MonitorModel:
     """Everything the monitor shows, from the messages and tokens it has seen."""
@@ -139,6 +203,8 @@ class MonitorModel:
     base: BaseCommand | None = None
     command: VelocityCommand | None = None
     result: dict[str, Any] | None = None
+    path: PathState | None = None
+    map: MapState | None = None
     moving: dict[str, bool] = field(default_factory=dict)
     recent: deque[Event] = field(default_factory=lambda: deque(maxlen=8))
     _events: list[Event] = field(default_factory=list)
@@ -251,6 +317,13 @@ class MonitorModel:
             self.decision = message
             self.emit(now, "decision", scenario=message.scenario, action=message.action,
                       obstacle=message.obstacle, kind=message.kind, stamp=message.stamp)
+        elif isinstance(message, GlobalPath):
+            plans = 1 if self.path is None else self.path.plans + 1
+            self.path = PathState(message, now, path_length(message.points), plans)
+            self.emit(now, "path", reason=message.reason, waypoints=len(message.points),
+                      length=round(self.path.length, 3), stamp=message.stamp)
+        elif isinstance(message, OccupancyMap):
+            self.map = MapState.of(message, now)
         elif isinstance(message, RunResult):
             result = {"outcome": message.outcome, "time": message.time,
                       "path_length": round(message.path_length, 4),
@@ -316,5 +389,44 @@ class MonitorModel:
             "latency": {k: (round(v, 6) if isinstance(v, float) else v)
                         for k, v in self.latency.stats().items()},
             "result": self.result,
+            "path": self._path_snapshot(now),
+            "map": self._map_snapshot(now),
             "rejected": dict(self.rejected),
         }
+
+    def robot_xy(self) -> tuple[float, float] | None:
+        """Where the robot is: odometry (the planner's frame), else ground truth."""
+        source = self.odom if self.odom is not None else self.truth
+        return None if source is None else (source.pose.x, source.pose.y)
+
+    def _path_snapshot(self, now: float) -> dict[str, Any] | None:
+        if self.path is None:
+            return None
+        path = self.path
+        points = path.message.points
+        to_go = off_path = None
+        robot = self.robot_xy()
+        if robot is not None and path.found:
+            along, off = along_path(points, *robot)
+            to_go, off_path = round(along, 3), round(off, 3)
+        return {"stamp": path.message.stamp, "seq": path.message.seq,
+                "reason": path.message.reason, "waypoints": len(points),
+                "length": round(path.length, 3), "found": path.found,
+                "goal": [round(float(v), 3) for v in points[-1]] if path.found else None,
+                "age": round(now - path.received, 3), "plans": path.plans,
+                "to_go": to_go, "off_path": off_path,
+                "points": [[round(float(x), 3), round(float(y), 3)] for x, y in points]}
+
+    def _map_snapshot(self, now: float) -> dict[str, Any] | None:
+        if self.map is None:
+            return None
+        m = self.map
+        grid = m.message
+        return {"stamp": grid.stamp, "seq": grid.seq, "width": grid.width,
+                "height": grid.height, "resolution": grid.resolution,
+                "origin": [round(grid.origin[0], 4), round(grid.origin[1], 4)],
+                "size": [round(grid.width * grid.resolution, 3),
+                         round(grid.height * grid.resolution, 3)],
+                "known_fraction": round(m.known / m.cells, 4),
+                "occupied_fraction": round(m.occupied / m.cells, 4),
+                "occupied_cells": m.occupied, "age": round(now - m.received, 3)}

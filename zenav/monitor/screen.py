@@ -3,17 +3,60 @@
 from __future__ import annotations
 
 import time
+from itertools import groupby
 from typing import Any
 
 from zenav.monitor.model import MonitorModel
+from zenav.monitor.view import LEGEND, STYLES, Window, map_view
 
 
 def _ms(value: float | int | None) -> str:
     return "-" if value is None else f"{1000 * value:.1f} ms"
 
 
-def render(model: MonitorModel, now: float) -> Any:
-    """The monitor's screen for ``rich``."""
+def path_line(path: dict[str, Any] | None) -> str:
+    """One line on the global path, from the snapshot's ``path``."""
+    if path is None:
+        return "global path: none heard yet (the planner sends it when it plans again)"
+    if not path["found"]:
+        return (f"global path: no way known (t={path['stamp']:.1f} s, {path['reason']}, "
+                f"{path['age']:.1f} s ago)")
+    line = (f"global path: {path['length']:.2f} m, {path['waypoints']} waypoints, planned "
+            f"{path['age']:.1f} s ago at t={path['stamp']:.1f} s "
+            f"({path['reason'] or 'no reason given'}), {path['plans']} heard")
+    if path["to_go"] is not None:
+        line += f"; to go {path['to_go']:.2f} m, off it {path['off_path']:.2f} m"
+    return line
+
+
+def map_line(occupancy: dict[str, Any] | None) -> str:
+    """One line on the occupancy map, from the snapshot's ``map``."""
+    if occupancy is None:
+        return "map: none heard yet"
+    w, h = occupancy["size"]
+    return (f"map: {occupancy['width']} x {occupancy['height']} cells of "
+            f"{occupancy['resolution']:.2f} m ({w:.1f} x {h:.1f} m), known "
+            f"{100 * occupancy['known_fraction']:.1f} %, occupied "
+            f"{100 * occupancy['occupied_fraction']:.2f} %, t={occupancy['stamp']:.1f} s, "
+            f"{occupancy['age']:.1f} s old")
+
+
+def view_rows(model: MonitorModel, scale: float = 0.25) -> list[str] | None:
+    """The map view round the robot (see :mod:`.view`); None before the robot's pose is
+    known."""
+    source = model.odom if model.odom is not None else model.truth
+    if source is None:
+        return None
+    pose = source.pose
+    tracks = [(t.x, t.y, t.kind) for t in (model.tracks.tracks if model.tracks else [])]
+    return map_view(Window((pose.x, pose.y), scale),
+                    None if model.map is None else model.map.message,
+                    None if model.path is None else model.path.message.points,
+                    tracks, pose.heading)
+
+
+def render(model: MonitorModel, now: float, scale: float = 0.25) -> Any:
+    """The monitor's screen for ``rich``; the map view ``scale`` m per character column."""
     from rich.console import Group
     from rich.table import Table
     from rich.text import Text
@@ -78,11 +121,26 @@ def render(model: MonitorModel, now: float) -> Any:
         obstacles.add_row(str(o["id"]), o["kind"], f"{o['x']:.2f}", f"{o['y']:.2f}",
                           f"{o['speed']:.2f}", f"{o['heading_deg']:.0f}°")
 
+    ways = Text(path_line(snap["path"]) + "\n" + map_line(snap["map"]))
+    rows = view_rows(model, scale)
+    view = Text()
+    if rows is None:
+        view.append("(no pose yet)")
+    else:
+        for k, row in enumerate(rows):
+            for char, run in groupby(row):
+                view.append(char * len(list(run)), style=STYLES.get(char))
+            if k < len(rows) - 1:
+                view.append("\n")
+    view_box = Group(Text(f"map round the robot ({scale:g} m per column, {2 * scale:g} m per "
+                          "row)", style="bold"), view, Text(LEGEND, style="dim"))
+
     events = Text("\n".join(
         f"{time.strftime('%H:%M:%S', time.localtime(e.wall))} {e.kind} "
         + " ".join(f"{k}={v}" for k, v in e.data.items()) for e in model.recent))
     middle = Table.grid(padding=(0, 2))
     middle.add_row(services, rates)
-    bottom = Table.grid(padding=(0, 2))
-    bottom.add_row(obstacles, Group(Text("recent events", style="bold"), events))
-    return Group(header, robot, plan, lat, middle, bottom)
+    spatial = Table.grid(padding=(0, 2))
+    spatial.add_row(view_box, obstacles)
+    return Group(header, robot, plan, ways, lat, middle, spatial,
+                 Text("recent events", style="bold"), events)
