@@ -32,7 +32,6 @@ from typing import Any
 
 from zenav.engine import ENGINES, first_difference
 from zenav.run import run_scenario
-from zenav.sim.scenario import load_scenario
 
 DEFAULT_VERIFY = 3
 """In-process jobs re-run through the stack to show the two engines agree."""
@@ -86,16 +85,13 @@ def run_job(job: Job, *, log_level: str = "INFO", reuse: bool = False,
         reused: dict[str, Any] = json.loads(record_path.read_text())
         return reused
     try:
+        # run_scenario draws run.png itself: it has the planner's last map to draw.
         record = run_scenario(job.scenario, job.out, planner=job.planner, log_level=log_level,
-                              picture=False, profile=job.profile, engine=engine)
+                              picture=picture, profile=job.profile, engine=engine)
     except Exception as exc:
         if not keep_going:
             raise
         return error_record(job, (str(exc).strip().splitlines() or [type(exc).__name__])[-1])
-    if picture:
-        from zenav.plot import plot_run  # matplotlib is slow to import; only here
-
-        plot_run(load_scenario(job.scenario), record, job.out / "run.png")
     return record
 
 

@@ -18,6 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.colors import ListedColormap
 from matplotlib.patches import Circle, Rectangle
 
 from zenav.schemas.messages import OccupancyMap
@@ -26,6 +27,10 @@ from zenav.sim.scenario import ObstacleSpec, Scenario
 OUTCOME_COLOURS = {"reached": "tab:green", "collision": "tab:red", "timeout": "tab:orange"}
 STATIC_COLOUR = "0.35"
 MOVER_COLOUR = "tab:purple"
+MAP_FREE_COLOUR = "#dce9f5"
+MAP_OCCUPIED_COLOUR = "#f2a65a"
+"""The planner's map in run.png: cells it has seen free, and cells it holds occupied
+(obstacles grown by the robot radius and margin); unknown cells are left blank."""
 
 PLOT_LOCK = threading.RLock()
 """Held while a figure is drawn (pyplot is not thread-safe)."""
@@ -63,6 +68,22 @@ def _global_path(ax: Any, scenario: Scenario, lw: float = 1, label: str | None =
             label=label)
 
 
+def draw_occupancy(ax: Any, occupancy: OccupancyMap) -> None:
+    """The planner's map under everything else: seen-free cells pale blue, occupied cells
+    orange, unknown ones blank; with a legend entry for each."""
+    grid = occupancy.grid()
+    values = np.where(grid < 0, np.nan, np.where(grid > 50, 1.0, 0.0))
+    colours = ListedColormap([MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR]).with_extremes(
+        bad=(0.0, 0.0, 0.0, 0.0))
+    x0, y0 = occupancy.origin
+    r = occupancy.resolution
+    ax.imshow(values.T, origin="lower", cmap=colours, vmin=0.0, vmax=1.0,
+              extent=(x0, x0 + r * occupancy.width, y0, y0 + r * occupancy.height),
+              interpolation="nearest", zorder=0)
+    ax.fill([], [], color=MAP_FREE_COLOUR, label="map: seen free")
+    ax.fill([], [], color=MAP_OCCUPIED_COLOUR, label="map: occupied (grown)")
+
+
 def _finish(fig: Any, ax: Any, path: Path, legend: str) -> None:
     """Axis labels and legend; write ``path`` and close the figure."""
     ax.set_xlabel("x [m]")
@@ -84,20 +105,14 @@ def _nearest_rows(record: dict[str, Any], t: float) -> int:
 def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
              occupancy: OccupancyMap | None = None) -> None:
     """Write ``path`` (PNG) for a run record as written to run.json; with the planner's
-    last map when given (occupied cells dark, free ones light), and its last global path
-    when the record has one (``path``)."""
+    last map when given (:func:`draw_occupancy`), and its last global path when the
+    record has one (``path``; else the straight start-goal line)."""
     width, height = scenario.world.size
     with PLOT_LOCK:
         fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
         _world(ax, scenario, "0.92", max_cells=60)
         if occupancy is not None:
-            grid = occupancy.grid().astype(float)
-            shade = np.where(grid < 0, np.nan, np.where(grid > 50, 0.55, 0.97))
-            x0, y0 = occupancy.origin
-            r = occupancy.resolution
-            ax.imshow(shade.T, origin="lower", cmap="gray", vmin=0.0, vmax=1.0, alpha=0.6,
-                      extent=(x0, x0 + r * occupancy.width, y0, y0 + r * occupancy.height),
-                      interpolation="nearest", zorder=0)
+            draw_occupancy(ax, occupancy)
             ax.set_xlim(0, width)
             ax.set_ylim(0, height)
         end = float(record["time"])

@@ -1,0 +1,90 @@
+"""run.png: the planner's map (seen free, occupied, unknown) and its last global path,
+read back from the picture's pixels."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib.image
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgb
+
+import zenav.plot
+from zenav.plot import MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR, plot_run
+from zenav.schemas.messages import OccupancyMap
+from zenav.sim.scenario import load_scenario
+
+REPO = Path(__file__).resolve().parents[2]
+SCENARIO = REPO / "sim" / "scenarios" / "nav-wall-gap.yaml"  # 10 x 8 m, a wall at x = 5
+
+
+def record(path: list[list[float]] | None) -> dict[str, Any]:
+    rows = [[t, 2.0 + 0.05 * t, 3.0, 0.0, 0.05] for t in np.arange(0.0, 10.0, 0.1)]
+    data: dict[str, Any] = {"scenario": "nav-wall-gap", "planner": "paper", "outcome": "timeout",
+                            "time": 9.9, "path_length": 0.5, "min_clearance": 1.0,
+                            "trajectory": rows, "events": []}
+    if path is not None:
+        data["path"] = path
+    return data
+
+
+def occupancy() -> OccupancyMap:
+    """Free for x < 4 m, a block held occupied at x 3.0-3.5, y 6-7 (no obstacle there),
+    unknown beyond x = 4 m."""
+    grid = np.full((100, 80), -1, dtype=np.int8)  # [ix, iy], 0.1 m cells
+    grid[:40, :] = 0
+    grid[30:35, 60:70] = 100
+    return OccupancyMap(stamp=9.9, seq=9, origin=(0.0, 0.0), resolution=0.1, width=100,
+                        height=80, cells=np.ascontiguousarray(grid.T).ravel())
+
+
+class Picture:
+    """plot_run's PNG, read back, with the axes it was drawn on."""
+
+    def __init__(self, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, run: dict[str, Any],
+                 grid: OccupancyMap | None) -> None:
+        kept: list[tuple[Any, Any]] = []
+        finish = zenav.plot._finish
+
+        def keep(fig: Any, ax: Any, path: Path, legend: str) -> None:
+            finish(fig, ax, path, legend)
+            kept.append((fig, ax))
+
+        monkeypatch.setattr(zenav.plot, "_finish", keep)
+        out = tmp_path / "run.png"
+        plot_run(load_scenario(SCENARIO), run, out, occupancy=grid)
+        (self.fig, self.ax), = kept
+        self.pixels = matplotlib.image.imread(out)[:, :, :3]
+        self.labels = self.ax.get_legend_handles_labels()[1]
+
+    def at(self, x: float, y: float) -> tuple[float, ...]:
+        """The RGB of the picture at world point (x, y)."""
+        scale = 110 / self.fig.dpi  # saved at 110 dpi
+        px, py = self.ax.transData.transform((x, y)) * scale
+        row = self.pixels.shape[0] - round(float(py))
+        return tuple(float(v) for v in self.pixels[row, round(float(px))])
+
+
+def near(colour: tuple[float, ...], expected: str, tol: float = 0.03) -> bool:
+    return bool(np.allclose(colour, to_rgb(expected), atol=tol))
+
+
+def test_run_png_shows_the_map_free_occupied_and_unknown(tmp_path, monkeypatch):
+    picture = Picture(tmp_path, monkeypatch, record([[2.0, 3.0], [4.2, 5.0], [8.0, 3.0]]),
+                      occupancy())
+    assert near(picture.at(1.2, 6.2), MAP_FREE_COLOUR)
+    assert near(picture.at(3.2, 6.7), MAP_OCCUPIED_COLOUR)
+    assert near(picture.at(8.2, 6.7), "white")  # unknown: blank
+    assert {"map: seen free", "map: occupied (grown)", "global path (last)"} <= set(
+        picture.labels)
+    # The last global path, dashed green, at its middle vertex.
+    assert near(picture.at(4.2, 5.0), "tab:green", tol=0.2)
+
+
+def test_run_png_without_a_map_or_path_shows_the_straight_line(tmp_path, monkeypatch):
+    picture = Picture(tmp_path, monkeypatch, record(None), None)
+    assert near(picture.at(1.2, 6.2), "white") and near(picture.at(3.2, 6.7), "white")
+    assert "global path" in picture.labels
+    assert not any(label.startswith("map:") for label in picture.labels)
