@@ -30,7 +30,7 @@ MOVER_COLOUR = "tab:purple"
 MAP_FREE_COLOUR = "#dce9f5"
 MAP_OCCUPIED_COLOUR = "#f2a65a"
 """The planner's map in run.png: cells it has seen free, and cells it holds occupied
-(obstacles grown by the robot radius and margin); unknown cells are left blank."""
+(confirmed hits, before inflation); unknown cells are left blank."""
 
 PLOT_LOCK = threading.RLock()
 """Held while a figure is drawn (pyplot is not thread-safe)."""
@@ -81,7 +81,7 @@ def draw_occupancy(ax: Any, occupancy: OccupancyMap) -> None:
               extent=(x0, x0 + r * occupancy.width, y0, y0 + r * occupancy.height),
               interpolation="nearest", zorder=0)
     ax.fill([], [], color=MAP_FREE_COLOUR, label="map: seen free")
-    ax.fill([], [], color=MAP_OCCUPIED_COLOUR, label="map: occupied (grown)")
+    ax.fill([], [], color=MAP_OCCUPIED_COLOUR, label="map: occupied")
 
 
 def _finish(fig: Any, ax: Any, path: Path, legend: str) -> None:

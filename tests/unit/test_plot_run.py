@@ -77,7 +77,7 @@ def test_run_png_shows_the_map_free_occupied_and_unknown(tmp_path, monkeypatch):
     assert near(picture.at(1.2, 6.2), MAP_FREE_COLOUR)
     assert near(picture.at(3.2, 6.7), MAP_OCCUPIED_COLOUR)
     assert near(picture.at(8.2, 6.7), "white")  # unknown: blank
-    assert {"map: seen free", "map: occupied (grown)", "global path (last)"} <= set(
+    assert {"map: seen free", "map: occupied", "global path (last)"} <= set(
         picture.labels)
     # The last global path, dashed green, at its middle vertex.
     assert near(picture.at(4.2, 5.0), "tab:green", tol=0.2)
