@@ -5,7 +5,9 @@ Read-only, from any host: it follows zenav's tracks and planner state and publis
 obstacle coloured by type, a velocity arrow per mover, the planner's scenario letter and
 action as text above the robot), in the odometry frame, and the planner's global path
 (``planner/path``) as ``nav_msgs/msg/Path`` on ``/zenav/plan`` whenever it is planned
-again. In RViz: Add > By topic > /zenav/markers and /zenav/plan.
+again, and its occupancy map (``planner/map``, about once a second) as
+``nav_msgs/msg/OccupancyGrid`` on ``/zenav/map``. In RViz: Add > By topic >
+/zenav/markers, /zenav/plan and /zenav/map (the map display's durability: volatile).
 """
 
 from __future__ import annotations
@@ -19,10 +21,10 @@ from typing import Any
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
-from zenav.schemas.messages import GlobalPath, PlannerState, TrackList
+from zenav.schemas.messages import GlobalPath, OccupancyMap, PlannerState, TrackList
 from zenav.services.ros2.node import Ros2Node
-from zenav.services.ros2.view import path_to_ros, tracks_to_markers
-from zenav.services.ros2.wire import MARKER_ARRAY, PATH, WireError, qualify
+from zenav.services.ros2.view import map_to_ros, path_to_ros, tracks_to_markers
+from zenav.services.ros2.wire import MARKER_ARRAY, OCCUPANCY_GRID, PATH, WireError, qualify
 from zenav.services.runner import add_transport_arguments
 from zenav.services.transport import Bus
 from zenav.tooling import (
@@ -36,22 +38,26 @@ from zenav.tooling import (
 
 class RvizView:
     """Tracks and planner state in, MarkerArray out (one per track list); global paths
-    in, Path out (one per path)."""
+    in, Path out (one per path); maps in, OccupancyGrid out (one per map)."""
 
     def __init__(self, bus: Bus, robot_id: str, *, domain_id: int = 0,
                  topic: str = "/zenav/markers", frame: str = "odom",
-                 path_topic: str = "/zenav/plan", node_name: str = "zenav_view") -> None:
+                 path_topic: str = "/zenav/plan", map_topic: str = "/zenav/map",
+                 node_name: str = "zenav_view") -> None:
         self.keys = Keys(robot_id)
         self.frame = frame
         self.ros = Ros2Node(bus, node_name, domain_id)
         self.markers = self.ros.publisher(qualify(topic), MARKER_ARRAY)
         self.path = self.ros.publisher(qualify(path_topic), PATH)
+        self.map = self.ros.publisher(qualify(map_topic), OCCUPANCY_GRID)
         self.tracks = bus.subscribe(self.keys.of(keys.TRACKS), depth=1)
         self.states = bus.subscribe(self.keys.of(keys.PLANNER_STATE), depth=1)
         self.paths = bus.subscribe(self.keys.of(keys.PATH), depth=1)
+        self.maps = bus.subscribe(self.keys.of(keys.MAP), depth=1)
         self.state: PlannerState | None = None
         self.sent = 0
         self.paths_sent = 0
+        self.maps_sent = 0
 
     def on_state(self, payload: bytes) -> None:
         with contextlib.suppress(DecodeError):
@@ -65,6 +71,14 @@ class RvizView:
         points = [(float(x), float(y)) for x, y in path.points]
         self.path.publish(path_to_ros(points, path.stamp, self.frame))
         self.paths_sent += 1
+
+    def on_map(self, payload: bytes) -> None:
+        try:
+            occupancy = decode(payload, OccupancyMap, self.keys.of(keys.MAP), keys.MAP.max_bytes)
+        except DecodeError:
+            return
+        self.map.publish(map_to_ros(occupancy, self.frame))
+        self.maps_sent += 1
 
     def on_tracks(self, payload: bytes) -> None:
         try:
@@ -84,8 +98,13 @@ class RvizView:
             while True:
                 self.on_path((await self.paths.get())[1])
 
+        async def maps() -> None:
+            while True:
+                self.on_map((await self.maps.get())[1])
+
         loop = asyncio.get_running_loop()
-        tasks = [loop.create_task(states()), loop.create_task(paths())]
+        tasks = [loop.create_task(states()), loop.create_task(paths()),
+                 loop.create_task(maps())]
         try:
             while True:
                 self.on_tracks((await self.tracks.get())[1])
@@ -97,6 +116,7 @@ class RvizView:
         self.tracks.close()
         self.states.close()
         self.paths.close()
+        self.maps.close()
         self.ros.close()
 
 
@@ -107,7 +127,7 @@ async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None
     if bus is None:  # stopped while connecting
         return
     view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame,
-                    path_topic=args.path_topic)
+                    path_topic=args.path_topic, map_topic=args.map_topic)
     task = asyncio.get_running_loop().create_task(view.run())
     try:
         await stop.wait()
@@ -123,7 +143,8 @@ def main(args: argparse.Namespace) -> int:
     setup = tool_setup(args, "rviz")
     if setup is None:
         return 2
-    for option, topic in (("--topic", args.topic), ("--path-topic", args.path_topic)):
+    for option, topic in (("--topic", args.topic), ("--path-topic", args.path_topic),
+                          ("--map-topic", args.map_topic)):
         try:
             qualify(topic)
         except WireError as exc:
@@ -135,15 +156,18 @@ def main(args: argparse.Namespace) -> int:
 
 def add_command(sub: Any) -> None:
     rviz = sub.add_parser(
-        "rviz", help="publish zenav's tracks, planner state and global path for RViz over "
-        "rmw_zenoh",
+        "rviz", help="publish zenav's tracks, planner state, global path and map for RViz "
+        "over rmw_zenoh",
         description="Tracked obstacles (type colour, velocity arrows) and the planner's "
-        "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic, and "
-        "the planner's global path as nav_msgs/msg/Path on another.")
+        "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic, "
+        "the planner's global path as nav_msgs/msg/Path on another and its occupancy map "
+        "as nav_msgs/msg/OccupancyGrid on a third.")
     rviz.add_argument("--domain-id", type=int, default=0, help="ROS_DOMAIN_ID (default 0)")
     rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
     rviz.add_argument("--path-topic", default="/zenav/plan",
                       help="Path topic (default /zenav/plan)")
+    rviz.add_argument("--map-topic", default="/zenav/map",
+                      help="OccupancyGrid topic (default /zenav/map)")
     rviz.add_argument("--frame", default="odom", help="frame of zenav's poses (default odom)")
     add_transport_arguments(rviz)
     add_connect_timeout(rviz)

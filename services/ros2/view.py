@@ -1,7 +1,8 @@
 """zenav's view of the world as RViz draws it (pure): tracked obstacles as a
 ``visualization_msgs/msg/MarkerArray`` (a cylinder per track coloured by type, an arrow
 for each moving one's velocity, the planner's scenario letter and action as text) and a
-planned path as ``nav_msgs/msg/Path``. Everything is in the odometry frame, the frame
+planned path as ``nav_msgs/msg/Path`` and the planner's occupancy map as
+``nav_msgs/msg/OccupancyGrid``. Everything is in the odometry frame, the frame
 zenav's poses are in.
 """
 
@@ -12,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from zenav.schemas.messages import PlannerState, Track, TrackList
-from zenav.services.ros2.convert import header, point, pose
-from zenav.services.ros2.wire import MARKER_ARRAY, PATH, message_class
+from zenav.schemas.messages import OccupancyMap, PlannerState, Track, TrackList
+from zenav.services.ros2.convert import header, point, pose, ros_time
+from zenav.services.ros2.wire import MARKER_ARRAY, OCCUPANCY_GRID, PATH, message_class
 
 ARROW, CYLINDER, TEXT = 0, 3, 9
 ADD, DELETEALL = 0, 3
@@ -95,3 +96,16 @@ def path_to_ros(points: Sequence[tuple[float, float]], stamp: float, frame: str)
     return message_class(PATH)(header=header(stamp, frame), poses=poses)
 
 
+
+
+def map_to_ros(occupancy: OccupancyMap, frame: str) -> Any:
+    """A ``nav_msgs/msg/OccupancyGrid`` of the planner's map: the same cells in the same
+    order (row by row from the origin's corner) and values (-1 unknown, 0 free, 100
+    occupied), the origin as the pose of cell (0, 0)'s corner."""
+    info = message_class("nav_msgs/msg/MapMetaData")(
+        map_load_time=ros_time(occupancy.stamp), resolution=float(occupancy.resolution),
+        width=occupancy.width, height=occupancy.height,
+        origin=pose(float(occupancy.origin[0]), float(occupancy.origin[1]), 0.0))
+    return message_class(OCCUPANCY_GRID)(
+        header=header(occupancy.stamp, frame), info=info,
+        data=np.asarray(occupancy.cells, dtype=np.int8))

@@ -41,7 +41,8 @@ TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 PATH = "nav_msgs/msg/Path"
-USED_TYPES = (LASER_SCAN, ODOMETRY, TWIST, TWIST_STAMPED, MARKER_ARRAY, PATH)
+OCCUPANCY_GRID = "nav_msgs/msg/OccupancyGrid"
+USED_TYPES = (LASER_SCAN, ODOMETRY, TWIST, TWIST_STAMPED, MARKER_ARRAY, PATH, OCCUPANCY_GRID)
 
 EntityKind = Literal["NN", "MP", "MS", "SS", "SC"]
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 import pytest
 
 from tests.ros2 import samples
-from zenav.schemas.messages import BaseCommand
+from zenav.schemas.messages import BaseCommand, OccupancyMap
 from zenav.services.motor_bridge.output import command_to_ros
 from zenav.services.ros2 import convert, view, wire
 from zenav.services.ros2.params import Ros2Params
@@ -79,4 +80,17 @@ def test_path():
     back = through_cdr(view.path_to_ros(points, 3.5, "odom"), wire.PATH)
     assert [(p.pose.position.x, p.pose.position.y) for p in back.poses] == points
     assert convert.yaw_of(back.poses[1].pose.orientation) == pytest.approx(math.pi / 2)
+    assert back.header.frame_id == "odom"
+
+
+def test_occupancy_grid():
+    cells = np.array([-1, 0, 100, 0, 0, -1], dtype=np.int8)  # 3 x 2, row by row
+    grid = OccupancyMap(stamp=2.25, seq=0, origin=(1.5, -2.0), resolution=0.05, width=3,
+                        height=2, cells=cells)
+    back = through_cdr(view.map_to_ros(grid, "odom"), wire.OCCUPANCY_GRID)
+    assert back.data.tolist() == cells.tolist()
+    assert (back.info.width, back.info.height) == (3, 2)
+    assert back.info.resolution == pytest.approx(0.05)
+    assert (back.info.origin.position.x, back.info.origin.position.y) == (1.5, -2.0)
+    assert convert.stamp_of(back.info.map_load_time) == 2.25
     assert back.header.frame_id == "odom"

@@ -14,7 +14,7 @@ from zenav.rviz import RvizView
 from zenav.schemas import keys
 from zenav.schemas.codec import encode
 from zenav.schemas.keys import Keys
-from zenav.schemas.messages import GlobalPath
+from zenav.schemas.messages import GlobalPath, OccupancyMap
 from zenav.services.ros2 import wire
 from zenav.services.transport import InMemoryBus
 
@@ -42,7 +42,7 @@ async def test_tracks_become_markers_for_rviz():
     assert {m.ns for m in markers} == {"", "tracks", "velocity", "planner"}
     assert next(m for m in markers if m.ns == "planner").text.startswith("(c) slow")
     assert {(t.kind, t.topic) for t in tokens} == {("NN", None), ("MP", "/zenav/markers"),
-                                                 ("MP", "/zenav/plan")}
+                                                 ("MP", "/zenav/plan"), ("MP", "/zenav/map")}
 
 
 async def test_global_path_becomes_a_ros_path():
@@ -73,3 +73,40 @@ async def test_global_path_becomes_a_ros_path():
     second = path.poses[1].pose.orientation  # facing the next point: +90 degrees
     assert 2 * math.atan2(second.z, second.w) == pytest.approx(math.pi / 2)
     assert ("MP", "/zenav/plan") in {(t.kind, t.topic) for t in tokens}
+
+
+async def test_the_map_becomes_a_ros_occupancy_grid():
+    bus = InMemoryBus()
+    view = RvizView(bus, "robot0", domain_id=3, frame="odom")
+    task = asyncio.create_task(view.run())
+    k = Keys("robot0")
+    grid = np.full((4, 3), -1, dtype=np.int8)  # [ix, iy]: 4 cells along x, 3 along y
+    grid[:2, :] = 0
+    grid[1, 2] = 100
+    cells = np.ascontiguousarray(grid.T).ravel()  # row by row, as the message holds them
+    try:
+        bus.deliver(k.of(keys.MAP), b"garbage")  # ignored, not fatal
+        await asyncio.sleep(0.01)
+        bus.deliver(k.of(keys.MAP), encode(OccupancyMap(
+            stamp=3.5, seq=0, origin=(-1.0, 2.0), resolution=0.1, width=4, height=3,
+            cells=cells)))
+        await asyncio.sleep(0.01)
+        key = wire.topic_key(3, "/zenav/map", wire.OCCUPANCY_GRID)
+        sent = [p for kk, p in bus.published if kk == key]
+        tokens = [wire.parse_token(t) for t in view.ros.tokens]
+    finally:
+        task.cancel()
+        view.close()
+    assert len(sent) == 1 and view.maps_sent == 1
+    ros_map = wire.deserialize(sent[0], wire.OCCUPANCY_GRID)
+    assert ros_map.header.frame_id == "odom"
+    assert (ros_map.header.stamp.sec, ros_map.header.stamp.nanosec) == (3, 500_000_000)
+    info = ros_map.info
+    assert (info.width, info.height) == (4, 3)
+    assert info.resolution == pytest.approx(0.1)
+    assert (info.origin.position.x, info.origin.position.y) == (-1.0, 2.0)
+    assert info.origin.orientation.w == 1.0
+    # ROS's order: row by row from the origin; cell (ix=1, iy=2) is data[2 * 4 + 1].
+    assert ros_map.data.tolist() == cells.tolist()
+    assert ros_map.data[2 * 4 + 1] == 100 and ros_map.data[3] == -1
+    assert ("MP", "/zenav/map") in {(t.kind, t.topic) for t in tokens}
