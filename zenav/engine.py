@@ -26,7 +26,7 @@ import contextlib
 import logging
 import selectors
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +44,9 @@ from zenav.services.transport import InMemoryBus
 ENGINES = ("stack", "inprocess")
 """How ``zenav run`` and the batch runner run a scenario: six processes over Zenoh (the
 acceptance path and the default), or this module's one process."""
+
+PATHS_KEPT = 10_000
+"""Global paths kept for run.png (the planner sends one each time it plans again)."""
 
 RESULT_TIMEOUT = 3600.0
 """Loop-clock seconds the engine waits for the simulator's result. The loop's clock
@@ -143,6 +146,7 @@ class EngineRun:
     counters: dict[str, dict[str, Any]]
     path: GlobalPath | None = None  # the newest global path the planner published
     occupancy: OccupancyMap | None = None  # and the newest map
+    paths: list[GlobalPath] = field(default_factory=list)  # every path, oldest first
 
 
 def unique_events(payloads: list[bytes], key: str) -> list[PlannerEvent]:
@@ -192,7 +196,7 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
 
     results = bus.subscribe(k.of(keys.RESULT), depth=1)
     live_events = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
-    paths = bus.subscribe(k.of(keys.PATH), depth=1)
+    paths = bus.subscribe(k.of(keys.PATH), depth=PATHS_KEPT)
     maps = bus.subscribe(k.of(keys.MAP), depth=1)
     spins: dict[str, asyncio.Task[None]] = {}
     for name in SERVICE_ORDER:
@@ -222,17 +226,18 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
         counters = {name: {"received": dict(node.received), "rejected": dict(node.rejected),
                            "handler_errors": node.handler_errors}
                     for name, node in nodes.items()}
-        path = occupancy = None
+        occupancy = None
+        heard: list[GlobalPath] = []
         while paths.pending():
             with contextlib.suppress(DecodeError):
-                path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
-                              keys.PATH.max_bytes)
+                heard.append(decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
+                                    keys.PATH.max_bytes))
         while maps.pending():
             with contextlib.suppress(DecodeError):
                 occupancy = decode((await maps.get())[1], OccupancyMap, k.of(keys.MAP),
                                    keys.MAP.max_bytes)
-        return EngineRun(result, unique_events(payloads, k.of(keys.EVENTS)), counters, path,
-                         occupancy)
+        return EngineRun(result, unique_events(payloads, k.of(keys.EVENTS)), counters,
+                         heard[-1] if heard else None, occupancy, heard)
     finally:
         # The simulator first, so that it does not log the others going away.
         nodes["simulator"].request_stop()

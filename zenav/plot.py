@@ -21,7 +21,7 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 from matplotlib.patches import Circle, Rectangle
 
-from zenav.schemas.messages import OccupancyMap
+from zenav.schemas.messages import GlobalPath, OccupancyMap
 from zenav.sim.scenario import ObstacleSpec, Scenario
 
 OUTCOME_COLOURS = {"reached": "tab:green", "collision": "tab:red", "timeout": "tab:orange"}
@@ -84,6 +84,27 @@ def draw_occupancy(ax: Any, occupancy: OccupancyMap) -> None:
     ax.fill([], [], color=MAP_OCCUPIED_COLOUR, label="map: occupied")
 
 
+EARLIER_PATH_COLOUR = "tab:olive"
+EARLIER_LISTED = 6
+"""Earlier paths named one by one in the legend; more are drawn and counted."""
+
+
+def draw_earlier_paths(ax: Any, paths: Sequence[GlobalPath]) -> None:
+    """Global paths the planner gave up (oldest first), thin and dotted, each numbered
+    at its first vertex; the legend gives the first few reasons."""
+    drawn = [p for p in paths if len(p.points) >= 2]
+    for k, earlier in enumerate(drawn, start=1):
+        xs, ys = earlier.points[:, 0], earlier.points[:, 1]
+        label = None
+        if k <= EARLIER_LISTED:
+            label = f"path {k} (t={earlier.stamp:.1f} s, {earlier.reason or 'no reason'})"
+        elif k == EARLIER_LISTED + 1:
+            label = f"paths {k}-{len(drawn)}"
+        ax.plot(xs, ys, ls=":", color=EARLIER_PATH_COLOUR, lw=0.9, alpha=0.8, label=label)
+        ax.annotate(str(k), (float(xs[0]), float(ys[0])), textcoords="offset points",
+                    xytext=(-8, -8), fontsize=6, color=EARLIER_PATH_COLOUR)
+
+
 def _finish(fig: Any, ax: Any, path: Path, legend: str) -> None:
     """Axis labels and legend; write ``path`` and close the figure."""
     ax.set_xlabel("x [m]")
@@ -103,10 +124,13 @@ def _nearest_rows(record: dict[str, Any], t: float) -> int:
 
 
 def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
-             occupancy: OccupancyMap | None = None) -> None:
+             occupancy: OccupancyMap | None = None,
+             paths: Sequence[GlobalPath] = ()) -> None:
     """Write ``path`` (PNG) for a run record as written to run.json; with the planner's
-    last map when given (:func:`draw_occupancy`), and its last global path when the
-    record has one (``path``; else the straight start-goal line)."""
+    last map when given (:func:`draw_occupancy`), its last global path when the record
+    has one (``path``; else the straight start-goal line), and the global paths planned
+    before it when given (``paths``, oldest first, the last being the record's), each
+    numbered at its first vertex with its reason in the legend."""
     width, height = scenario.world.size
     with PLOT_LOCK:
         fig, ax = plt.subplots(figsize=(7, 7 * height / width if width else 7))
@@ -133,9 +157,13 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
             ax.annotate(str(index), (cx, cy), ha="center", va="center", fontsize=7,
                         color="white")
         start, goal = scenario.robot.start, scenario.robot.goal
+        draw_earlier_paths(ax, paths[:-1])
         if record.get("path"):
             px, py = zip(*record["path"], strict=True)
-            ax.plot(px, py, ls="--", color="tab:green", lw=1, label="global path (last)")
+            last = "global path (last)" if not paths else (
+                f"global path (last: t={paths[-1].stamp:.1f} s, "
+                f"{paths[-1].reason or 'no reason'})")
+            ax.plot(px, py, ls="--", color="tab:green", lw=1, label=last)
         else:
             _global_path(ax, scenario, label="global path")
         traj = record["trajectory"]

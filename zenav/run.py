@@ -13,10 +13,11 @@ import contextlib
 import json
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from zenav.engine import PATHS_KEPT
 from zenav.launch import Stack
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
@@ -117,6 +118,7 @@ class Heard:
 
     path: GlobalPath | None = None
     occupancy: OccupancyMap | None = None
+    paths: list[GlobalPath] = field(default_factory=list)  # every path, oldest first
 
 
 async def _collect(stack: Stack, progress_timeout: float, record: Path | None = None,
@@ -165,7 +167,7 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
         odom = bus.subscribe(k.of(keys.ODOM), depth=1)
-        paths = bus.subscribe(k.of(keys.PATH), depth=1)
+        paths = bus.subscribe(k.of(keys.PATH), depth=PATHS_KEPT)
         maps = bus.subscribe(k.of(keys.MAP), depth=1)
         token = bus.declare_token(k.alive("run"))
         events: list[PlannerEvent] = []
@@ -185,6 +187,7 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
                 with contextlib.suppress(DecodeError):
                     heard.path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
                                         keys.PATH.max_bytes)
+                    heard.paths.append(heard.path)
             while maps.pending():
                 with contextlib.suppress(DecodeError):
                     heard.occupancy = decode((await maps.get())[1], OccupancyMap,
@@ -298,7 +301,7 @@ def run_scenario(
         except (EngineError, ConfigError) as exc:
             raise RunError(str(exc)) from None
         result, events = ran.result, ran.events
-        heard.path, heard.occupancy = ran.path, ran.occupancy
+        heard.path, heard.occupancy, heard.paths = ran.path, ran.occupancy, ran.paths
     else:
         stack = Stack(out_dir=out_dir, params=params, log_level=log_level, planner=planner)
         stack.start()
@@ -324,5 +327,6 @@ def run_scenario(
     if picture:
         from zenav.plot import plot_run  # matplotlib is slow to import; only here
 
-        plot_run(scenario, record, out_dir / "run.png", occupancy=heard.occupancy)
+        plot_run(scenario, record, out_dir / "run.png", occupancy=heard.occupancy,
+                 paths=heard.paths)
     return record

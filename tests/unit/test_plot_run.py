@@ -1,8 +1,9 @@
-"""run.png: the planner's map (seen free, occupied, unknown) and its last global path,
-read back from the picture's pixels."""
+"""run.png: the planner's map (seen free, occupied, unknown) read back from the picture's
+pixels, its last global path, and the paths it planned before, read from the axes."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -12,8 +13,8 @@ import pytest
 from matplotlib.colors import to_rgb
 
 import zenav.plot
-from zenav.plot import MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR, plot_run
-from zenav.schemas.messages import OccupancyMap
+from zenav.plot import EARLIER_PATH_COLOUR, MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR, plot_run
+from zenav.schemas.messages import GlobalPath, OccupancyMap
 from zenav.sim.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[2]
@@ -44,7 +45,7 @@ class Picture:
     """plot_run's PNG, read back, with the axes it was drawn on."""
 
     def __init__(self, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, run: dict[str, Any],
-                 grid: OccupancyMap | None) -> None:
+                 grid: OccupancyMap | None, paths: Sequence[GlobalPath] = ()) -> None:
         kept: list[tuple[Any, Any]] = []
         finish = zenav.plot._finish
 
@@ -54,7 +55,7 @@ class Picture:
 
         monkeypatch.setattr(zenav.plot, "_finish", keep)
         out = tmp_path / "run.png"
-        plot_run(load_scenario(SCENARIO), run, out, occupancy=grid)
+        plot_run(load_scenario(SCENARIO), run, out, occupancy=grid, paths=paths)
         (self.fig, self.ax), = kept
         self.pixels = matplotlib.image.imread(out)[:, :, :3]
         self.labels = self.ax.get_legend_handles_labels()[1]
@@ -88,3 +89,36 @@ def test_run_png_without_a_map_or_path_shows_the_straight_line(tmp_path, monkeyp
     assert near(picture.at(1.2, 6.2), "white") and near(picture.at(3.2, 6.7), "white")
     assert "global path" in picture.labels
     assert not any(label.startswith("map:") for label in picture.labels)
+
+
+def global_path(stamp: float, reason: str, points: list[list[float]]) -> GlobalPath:
+    return GlobalPath(stamp=stamp, seq=0, points=np.array(points), reason=reason)
+
+
+def test_run_png_shows_the_paths_given_up_numbered_with_their_reasons(tmp_path, monkeypatch):
+    last = [[3.7, 4.7], [8.0, 3.0]]
+    paths = [global_path(0.0, "start", [[2.0, 3.0], [8.0, 3.0]]),
+             global_path(4.0, "off the path", [[2.5, 3.5], [4.0, 4.3], [8.0, 3.0]]),
+             global_path(9.0, "recovery", np.zeros((0, 2)).tolist()),  # no way: not drawn
+             global_path(25.0, "recovery", last)]
+    picture = Picture(tmp_path, monkeypatch, record(last), None, paths)
+    lines = {line.get_label(): line for line in picture.ax.get_lines()}
+    first = lines["path 1 (t=0.0 s, start)"]
+    assert first.get_xdata().tolist() == [2.0, 8.0] and first.get_linestyle() == ":"
+    assert lines["path 2 (t=4.0 s, off the path)"].get_ydata().tolist() == [3.5, 4.3, 3.0]
+    assert lines["global path (last: t=25.0 s, recovery)"].get_xdata().tolist() == [3.7, 8.0]
+    assert not any(label.startswith("path 3") for label in lines)
+    numbers = [(t.get_text(), t.xy) for t in picture.ax.texts
+               if t.get_color() == EARLIER_PATH_COLOUR]
+    assert numbers == [("1", (2.0, 3.0)), ("2", (2.5, 3.5))]  # at each one's first vertex
+
+
+def test_run_png_names_the_first_paths_and_counts_the_rest(tmp_path, monkeypatch):
+    earlier = [global_path(float(k), "off the path", [[2.0, 3.0 + k / 10], [8.0, 3.0]])
+               for k in range(9)]
+    last = global_path(10.0, "off the path", [[2.0, 2.0], [8.0, 3.0]])
+    picture = Picture(tmp_path, monkeypatch, record(last.points.tolist()), None,
+                      [*earlier, last])
+    labels = picture.labels
+    assert [lb for lb in labels if lb.startswith("path")] == [
+        *(f"path {k} (t={k - 1}.0 s, off the path)" for k in range(1, 7)), "paths 7-9"]
