@@ -19,11 +19,10 @@ import logging
 import signal
 import sys
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pydantic import BaseModel
 
-from zenav.schemas.keys import Keys, check_robot_id
 from zenav.services.config import (
     DEFAULT_BASE_PORT,
     SERVICE_ORDER,
@@ -32,8 +31,14 @@ from zenav.services.config import (
     loopback_mesh,
     read_yaml,
 )
-from zenav.services.node import Node
 from zenav.services.transport import Bus, TransportConfig, ZenohBus
+
+if TYPE_CHECKING:
+    from zenav.schemas.keys import Keys
+
+# The message schemas (numpy, pydantic models) and the node runtime are imported where they
+# are used, not here: `zenav router` shares this module's transport options and would pay
+# for them on every restart.
 
 log = logging.getLogger(__name__)
 
@@ -151,6 +156,8 @@ def setup_logging(level: str, name: str) -> None:
 
 async def serve(name: str, bus: Bus, keys: Keys, params: Any, planner: str = "paper") -> None:
     """Build the service on ``bus`` and run it until stopped or until its run() ends."""
+    from zenav.services.node import Node
+
     node = Node(name, bus, keys)
     service = implementation(name, planner).Service(node, params)
     loop = asyncio.get_running_loop()
@@ -193,6 +200,8 @@ def main(name: str, argv: list[str] | None = None) -> int:
     add_transport_arguments(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
+    from zenav.schemas.keys import Keys, check_robot_id
+
     try:
         planner = getattr(args, "planner", "paper")
         params = load_params(service_params(name, planner), args.config, args.set)

@@ -198,6 +198,8 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
     programs.sort(key=lambda program: program[3])  # stable: the file's order within a rank
     for program, command, autostart, priority in programs:
         log = run_dir / "logs" / f"{program}.log"
+        if sup.nice != 0:  # nice execs the program: supervisord's pid is still the program's
+            command = ["nice", "-n", str(sup.nice), *command]
         lines += [
             "",
             f"[program:{program}]",
