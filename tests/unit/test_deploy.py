@@ -107,7 +107,8 @@ def test_a_program_may_be_any_command_standing_in_for_a_service(tmp_path):
     section = conf["program:planner_b"]
     assert section["autostart"] == "false" and section["priority"] == "70"
     assert shlex.split(section["command"].replace("%%", "%")) == [
-        "nice", "-n", "-5", "/py", "my_planner.py", "--transport", str(tmp_path / "run" / "transport.yaml"),
+        "nice", "-n", "-5", "/py", "my_planner.py", "--transport",
+        str(tmp_path / "run" / "transport.yaml"),
         "--robot-id", "robot0", "--value", "100%"]
     assert "100%%" in conf_text  # supervisord's expansion character is escaped
 

@@ -196,10 +196,10 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
         programs.append((program, program_command(deployment, program, run_dir, derived, python),
                          spec.autostart, priority))
     programs.sort(key=lambda program: program[3])  # stable: the file's order within a rank
-    for program, command, autostart, priority in programs:
+    for program, argv, autostart, priority in programs:
         log = run_dir / "logs" / f"{program}.log"
-        if sup.nice != 0:  # nice execs the program: supervisord's pid is still the program's
-            command = ["nice", "-n", str(sup.nice), *command]
+        # nice execs the program: supervisord's pid is still the program's
+        command = ["nice", "-n", str(sup.nice), *argv] if sup.nice != 0 else argv
         lines += [
             "",
             f"[program:{program}]",

@@ -71,8 +71,9 @@ def main(args: argparse.Namespace) -> int:
         log.error("cannot open the router on %s: %s", ", ".join(transport.listen), exc)
         return 1
     token = session.liveliness().declare_token(token_key(args.robot_id))
-    log.info("router up, listening on %s%s", ", ".join(transport.listen),
-             f", connected to {', '.join(transport.connect)}" if transport.connect else "")
+    joining = f", joining the routers at {', '.join(transport.connect)}" if transport.connect \
+        else ""
+    log.info("router up, listening on %s%s", ", ".join(transport.listen), joining)
     try:
         while not stop.wait(0.5):
             pass
