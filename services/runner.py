@@ -16,6 +16,7 @@ import asyncio
 import contextlib
 import importlib
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -146,6 +147,39 @@ def transport_from_args(args: argparse.Namespace, service: str | None) -> Transp
     return config
 
 
+def add_standby_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--standby-lock", type=Path, metavar="FILE",
+        help="serve only while holding this file's lock: two processes given the same FILE "
+             "make a pair, one serving and one a warm spare that has loaded everything and "
+             "takes over the moment the other ends (kill -9 included)")
+
+
+_HELD: list[int] = []
+"""Descriptors of the standby locks this process holds (kept open for its whole life: the
+kernel releases the lock when the process ends, however it ends)."""
+
+
+def take_over(lock: Path, name: str) -> None:
+    """Return once this process holds ``lock``, an exclusive ``flock`` on the file: at once
+    when no other process holds it, else the moment its holder ends. The holder's pid is
+    written into the file. Meanwhile SIGINT raises KeyboardInterrupt, and SIGTERM ends the
+    process (its default action: a spare has nothing to clean up)."""
+    import fcntl
+
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        log.info("standby: another process serves %s; taking over when it ends", name)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        log.info("standby: taking over %s", name)
+    _HELD.append(fd)
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+
+
 def setup_logging(level: str, name: str) -> None:
     logging.basicConfig(
         level=level.upper(),
@@ -198,6 +232,7 @@ def main(name: str, argv: list[str] | None = None) -> int:
         parser.add_argument("--planner", default="paper",
                             help=f"implementation: {', '.join(PLANNERS)} (default paper)")
     add_transport_arguments(parser)
+    add_standby_argument(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
     from zenav.schemas.keys import Keys, check_robot_id
@@ -211,6 +246,12 @@ def main(name: str, argv: list[str] | None = None) -> int:
         for line in str(exc).splitlines():  # one line per problem, each naming the service
             print(f"zenav {name}: {line}", file=sys.stderr)
         return 2
+    if args.standby_lock is not None:
+        try:
+            implementation(name, planner)  # everything loaded before waiting: a warm spare
+            take_over(args.standby_lock, name)
+        except KeyboardInterrupt:
+            return 0
 
     async def amain() -> None:
         bus = ZenohBus(transport, asyncio.get_running_loop())

@@ -196,3 +196,29 @@ def test_niceness_zero_runs_the_programs_as_they_are(tmp_path):
     commands = [shlex.split(conf[s]["command"]) for s in conf.sections()
                 if s.startswith("program:")]
     assert len(commands) == 7 and all(c[0] == "/py" for c in commands)
+
+
+def test_standby_pairs_every_service_and_the_router_with_a_warm_spare(tmp_path):
+    base = yaml.safe_load((DEPLOY / "stack.yaml").read_text())
+    base["scenario"] = str(DEPLOY / base["scenario"])
+    for spec in base["services"].values():
+        spec["config"] = [str(DEPLOY / p) for p in spec["config"]]
+    base["supervisor"]["standby"] = True
+    base["services"]["planner_b"] = {"service": "planner", "autostart": False,
+                                     "command": ["{python}", "my_planner.py"]}
+    path = tmp_path / "d.yaml"
+    path.write_text(yaml.safe_dump(base))
+    deployment = load_deployment(path)
+    conf = conf_of(prepare(deployment, tmp_path / "run", python="/py"))
+    programs = [s.removeprefix("program:") for s in conf.sections() if s.startswith("program:")]
+    served = ["router", "motor_bridge", "simulator", "laser_driver", "perception", "tracking",
+              "planner"]
+    assert [p for p in programs if p != "planner_b"] == [
+        p for name in served for p in (name, f"{name}_standby")]  # in start order
+    for name in served:
+        command = shlex.split(conf[f"program:{name}"]["command"])
+        assert command == shlex.split(conf[f"program:{name}_standby"]["command"])
+        assert command[-2:] == ["--standby-lock",
+                                str(tmp_path / "run" / "standby" / f"{name}.lock")]
+        assert conf[f"program:{name}"]["priority"] == conf[f"program:{name}_standby"]["priority"]
+    assert "--standby-lock" not in conf["program:planner_b"]["command"]

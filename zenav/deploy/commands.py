@@ -12,7 +12,7 @@ import xmlrpc.client
 from pathlib import Path
 from typing import Any
 
-from zenav.deploy.conf import default_run_dir, prepare, socket_path
+from zenav.deploy.conf import default_run_dir, prepare, socket_path, standby_twins
 from zenav.deploy.model import DEFAULT_CONFIG, Deployment, load_deployment
 from zenav.deploy.rpc import Supervisor, unclean_stops
 from zenav.deploy.wait import check_started, expected_alive, wait_alive, wait_running
@@ -81,6 +81,7 @@ def cmd_up(args: argparse.Namespace) -> int:
         programs = [p for p, s in deployment.services.items() if s.autostart]
         if deployment.router is not None:
             programs.insert(0, "router")
+        programs += standby_twins(deployment).values()
         wait_running(sup, programs, args.timeout)
         if not args.no_wait:
             missing = wait_alive(deployment, expected_alive(deployment), args.timeout,

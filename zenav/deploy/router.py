@@ -20,7 +20,13 @@ from typing import Any
 import zenoh
 
 from zenav.services.config import ConfigError
-from zenav.services.runner import add_transport_arguments, setup_logging, transport_from_args
+from zenav.services.runner import (
+    add_standby_argument,
+    add_transport_arguments,
+    setup_logging,
+    take_over,
+    transport_from_args,
+)
 from zenav.services.transport import TransportConfig
 
 log = logging.getLogger(__name__)
@@ -63,6 +69,11 @@ def main(args: argparse.Namespace) -> int:
     def on_signal(signum: int, frame: FrameType | None) -> None:
         stop.set()
 
+    if args.standby_lock is not None:
+        try:
+            take_over(args.standby_lock, "router")
+        except KeyboardInterrupt:
+            return 0
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, on_signal)
     try:
@@ -89,4 +100,5 @@ def add_command(sub: Any) -> None:
                             "services and monitors)")
     router.add_argument("--log-level", default="INFO")
     add_transport_arguments(router)
+    add_standby_argument(router)
     router.set_defaults(func=main)
