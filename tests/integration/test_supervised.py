@@ -256,7 +256,7 @@ def test_with_warm_spares_a_killed_program_is_replaced_at_once_on_a_busy_machine
                 arrivals.close()
             times[program] = (pause, back)
             measure(f"kill -9 {program} with a warm spare, {len(busy_machine)} busy loops -> "
-                    f"data flowing again ({output})", back, f"longest pause {pause:.3f} s")
+                    f"longest pause of {output}", pause, f"it ended {back:.3f} s after the kill")
             after = stack.pids()
             spare = before[twin] if serving == before[program] else before[program]
             assert int(lock.read_text()) == spare  # the spare serves now
@@ -272,7 +272,9 @@ def test_with_warm_spares_a_killed_program_is_replaced_at_once_on_a_busy_machine
         stopped = stack.down() if stack.is_up else None
         stack.cleanup()
     assert stopped is not None and stopped.returncode == 0, stopped
-    assert all(back < LOADED_WAIT for _, back in times.values()), times
+    # The target is 1 s; this bound only catches a takeover that does not happen (the
+    # figures above are the result).
+    assert all(pause < LOADED_WAIT for pause, _ in times.values()), times
 
 
 def test_the_planner_replaced_mid_run_stops_the_robot_meanwhile_and_it_reaches_the_goal(
