@@ -6,7 +6,8 @@ default), pure modules, and a thin ``node.py`` with ``Service``, built as
 A service with work of its own (the simulator's clock, the motor bridge's watchdog)
 has ``async def run()``; when ``run`` returns, the process stops. SIGINT and SIGTERM
 stop it cleanly: inputs cancelled, liveliness token and declarations undeclared,
-session closed.
+session closed. With ``--standby-lock FILE`` it loads everything, then serves only once it
+holds the file's lock: a pair of such processes is a service and its warm spare.
 """
 
 from __future__ import annotations
