@@ -13,6 +13,7 @@ import signal
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -189,8 +190,8 @@ class Arrivals:
         from zenav.tooling import client_transport
 
         self.times: list[float] = []
-        self.session = zenoh.open(client_transport([endpoint]).to_zenoh())
-        self.subscriber = self.session.declare_subscriber(
+        self.session: Any = zenoh.open(client_transport([endpoint]).to_zenoh())
+        self.subscriber: Any = self.session.declare_subscriber(
             key, lambda sample: self.times.append(time.time()))
 
     def steady(self, count: int, timeout: float) -> None:
@@ -287,7 +288,10 @@ def test_the_planner_replaced_mid_run_stops_the_robot_meanwhile_and_it_reaches_t
         "--goal", str(goal[0]), str(goal[1]), "--speed", str(speed)]}
     services = copy_deployment(REPO / "deploy" / "stack.yaml", tmp_path / "base.yaml")
     programs = yaml.safe_load(services.read_text())["services"]
-    stack, endpoint = one_host(tmp_path, services={**programs, "planner_b": replacement})
+    # Real time: 40 s of driving, so that on a loaded machine the run is still under way
+    # when `zenav up` returns and the monitor joins.
+    stack, endpoint = one_host(tmp_path, speed=1.0,
+                               services={**programs, "planner_b": replacement})
     monitor = None
     try:
         stack.up()
