@@ -6,7 +6,8 @@ default), pure modules, and a thin ``node.py`` with ``Service``, built as
 A service with work of its own (the simulator's clock, the motor bridge's watchdog)
 has ``async def run()``; when ``run`` returns, the process stops. SIGINT and SIGTERM
 stop it cleanly: inputs cancelled, liveliness token and declarations undeclared,
-session closed.
+session closed. With ``--standby-lock FILE`` it loads everything, then serves only once it
+holds the file's lock: a pair of such processes is a service and its warm spare.
 """
 
 from __future__ import annotations
@@ -16,14 +17,14 @@ import asyncio
 import contextlib
 import importlib
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pydantic import BaseModel
 
-from zenav.schemas.keys import Keys, check_robot_id
 from zenav.services.config import (
     DEFAULT_BASE_PORT,
     SERVICE_ORDER,
@@ -32,8 +33,14 @@ from zenav.services.config import (
     loopback_mesh,
     read_yaml,
 )
-from zenav.services.node import Node
 from zenav.services.transport import Bus, TransportConfig, ZenohBus
+
+if TYPE_CHECKING:
+    from zenav.schemas.keys import Keys
+
+# The message schemas (numpy, pydantic models) and the node runtime are imported where they
+# are used, not here: `zenav router` shares this module's transport options and would pay
+# for them on every restart.
 
 log = logging.getLogger(__name__)
 
@@ -141,6 +148,39 @@ def transport_from_args(args: argparse.Namespace, service: str | None) -> Transp
     return config
 
 
+def add_standby_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--standby-lock", type=Path, metavar="FILE",
+        help="serve only while holding this file's lock: two processes given the same FILE "
+             "make a pair, one serving and one a warm spare that has loaded everything and "
+             "takes over the moment the other ends (kill -9 included)")
+
+
+_HELD: list[int] = []
+"""Descriptors of the standby locks this process holds (kept open for its whole life: the
+kernel releases the lock when the process ends, however it ends)."""
+
+
+def take_over(lock: Path, name: str) -> None:
+    """Return once this process holds ``lock``, an exclusive ``flock`` on the file: at once
+    when no other process holds it, else the moment its holder ends. The holder's pid is
+    written into the file. Meanwhile SIGINT raises KeyboardInterrupt, and SIGTERM ends the
+    process (its default action: a spare has nothing to clean up)."""
+    import fcntl
+
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        log.info("standby: another process serves %s; taking over when it ends", name)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        log.info("standby: taking over %s", name)
+    _HELD.append(fd)
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+
+
 def setup_logging(level: str, name: str) -> None:
     logging.basicConfig(
         level=level.upper(),
@@ -151,6 +191,8 @@ def setup_logging(level: str, name: str) -> None:
 
 async def serve(name: str, bus: Bus, keys: Keys, params: Any, planner: str = "paper") -> None:
     """Build the service on ``bus`` and run it until stopped or until its run() ends."""
+    from zenav.services.node import Node
+
     node = Node(name, bus, keys)
     service = implementation(name, planner).Service(node, params)
     loop = asyncio.get_running_loop()
@@ -191,8 +233,11 @@ def main(name: str, argv: list[str] | None = None) -> int:
         parser.add_argument("--planner", default="paper",
                             help=f"implementation: {', '.join(PLANNERS)} (default paper)")
     add_transport_arguments(parser)
+    add_standby_argument(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
+    from zenav.schemas.keys import Keys, check_robot_id
+
     try:
         planner = getattr(args, "planner", "paper")
         params = load_params(service_params(name, planner), args.config, args.set)
@@ -202,6 +247,12 @@ def main(name: str, argv: list[str] | None = None) -> int:
         for line in str(exc).splitlines():  # one line per problem, each naming the service
             print(f"zenav {name}: {line}", file=sys.stderr)
         return 2
+    if args.standby_lock is not None:
+        try:
+            implementation(name, planner)  # everything loaded before waiting: a warm spare
+            take_over(args.standby_lock, name)
+        except KeyboardInterrupt:
+            return 0
 
     async def amain() -> None:
         bus = ZenohBus(transport, asyncio.get_running_loop())

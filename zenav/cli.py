@@ -17,16 +17,17 @@ loaded 2-core machine)."""
 
 def build_light_parser(command: str) -> argparse.ArgumentParser:
     """The parser of one of the :data:`LIGHT` commands only."""
-    from zenav import stackcmd
-    from zenav.deploy import router
-
     parser = argparse.ArgumentParser(
         prog="zenav", description="Mobile-robot navigation as Zenoh services."
     )
     sub = parser.add_subparsers(dest="command", required=True)
     if command == "router":
+        from zenav.deploy import router
+
         router.add_command(sub)
     else:
+        from zenav import stackcmd
+
         stackcmd.add_commands(sub)
     return parser
 

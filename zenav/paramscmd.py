@@ -8,7 +8,6 @@ Every parameter of a service with its value and where the value came from: ``def
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +46,7 @@ def run(args: argparse.Namespace) -> int:
     from zenav.services.profiles import profile_layer
     from zenav.services.runner import service_params
     from zenav.sim.scenario import ScenarioError, load_scenario
+    from zenav.stackcmd import say_each
 
     try:
         model = service_params(args.name, args.planner)
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         layers += [assignment_layer(text) for text in args.set]
         _, settings = resolve(model, layers)
     except (ConfigError, ScenarioError) as exc:
-        print(f"zenav params: {'; '.join(str(exc).splitlines())}", file=sys.stderr)
+        say_each("zenav params", exc)  # one line per problem
         return 2
     title = f"{args.name}: every parameter, its value and its origin (zenav params {args.name})"
     print(show_settings(title, settings))

@@ -81,19 +81,83 @@ def test_a_service_started_by_hand_stops_on_sigint_within_a_second() -> None:
     assert code == 0
 
 
-def test_the_by_hand_stack_drives_to_the_scenarios_goal(tmp_path: Path) -> None:
-    """The README's loop writes each service's scenario parameters, then starts it with
-    them under deploy/params: the planner must read the scenario's goal, not (6, 0)."""
-    for service in ("laser_driver", "perception", "tracking", "planner", "motor_bridge"):
-        done = zenav("params", service, "--scenario", SCENARIO)
-        assert done.returncode == 0, done.stderr
-        (tmp_path / f"{service}.yaml").write_text(done.stdout)
-        check = zenav("params", service, "--params", str(tmp_path / f"{service}.yaml"),
-                      "--params", f"deploy/params/{service}.yaml")
-        assert check.returncode == 0, check.stderr
-    planner = zenav("params", "planner", "--params", str(tmp_path / "planner.yaml"),
-                    "--params", "deploy/params/planner.yaml")
-    assert f"goal: [8.0, 3.0]  # file {tmp_path / 'planner.yaml'}" in planner.stdout
+BY_HAND = ("laser_driver", "perception", "tracking", "planner", "motor_bridge")
+"""The services the README's loop starts in the background (the simulator comes last)."""
+
+BY_HAND_WATCH = 12.0
+"""s the by-hand stack is recorded in real time: long enough for a global path and a metre
+or so of driving (the run itself takes a minute)."""
+
+
+def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: Path) -> None:
+    """The README's by-hand commands, as given (one liberty: ``--base-port`` on a free
+    block, so that nothing else on the machine is met): each service's scenario parameters
+    written by ``zenav params``, five services in the background, the simulator last. The
+    planner must head for the scenario's goal (8, 3), not its default (6, 0): its global
+    path ends there and the robot drives along y = 3."""
+    from zenav.bag.mcapfile import read_bag
+    from zenav.schemas.codec import decode
+    from zenav.schemas.messages import GlobalPath, Odometry, PlannerState
+    from zenav.sim.scenario import load_scenario
+
+    scenario = load_scenario(REPO / SCENARIO)
+    port = ["--base-port", str(free_port_block(7))]
+    procs: dict[str, subprocess.Popen[str]] = {}
+    logs = tmp_path / "logs"
+    logs.mkdir()
+
+    def start(name: str, *args: str) -> None:
+        procs[name] = subprocess.Popen(
+            [ZENAV, *args, *port], cwd=REPO, stdin=subprocess.DEVNULL, text=True,
+            stdout=subprocess.DEVNULL, stderr=(logs / f"{name}.log").open("w"))
+
+    bag = tmp_path / "by-hand.mcap"
+    try:
+        # The recorder first, so that it hears the planner's first global path (published
+        # when it is planned) and the first scans.
+        procs["record"] = subprocess.Popen([ZENAV, "record", str(bag), *port], cwd=REPO,
+                                           stdin=subprocess.DEVNULL, text=True,
+                                           stdout=subprocess.DEVNULL,
+                                           stderr=(logs / "record.log").open("w"))
+        for service in BY_HAND:
+            done = zenav("params", service, "--scenario", SCENARIO)
+            assert done.returncode == 0, done.stderr
+            assert first_line(done.stdout).startswith(f"# {service}: every parameter")
+            (tmp_path / f"{service}.yaml").write_text(done.stdout)
+            start(service, "service", service, "--config", str(tmp_path / f"{service}.yaml"),
+                  "--config", f"deploy/params/{service}.yaml")
+        start("simulator", "service", "simulator", "--config", "deploy/params/simulator.yaml")
+        deadline = time.monotonic() + 180
+        moved = False
+        while time.monotonic() < deadline and not moved:
+            time.sleep(2)
+            for name, proc in procs.items():
+                assert proc.poll() is None, f"{name} exited: {(logs / f'{name}.log').read_text()}"
+            moved = "all services alive" in (logs / "simulator.log").read_text()
+        assert moved, (logs / "simulator.log").read_text()
+        time.sleep(BY_HAND_WATCH)
+    finally:
+        for proc in procs.values():
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+        codes = {}
+        for name, proc in procs.items():
+            try:
+                codes[name] = proc.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                codes[name] = proc.wait()
+    assert codes == {name: 0 for name in procs}, codes
+    goal = list(scenario.robot.goal)
+    paths = [decode(m.payload, GlobalPath) for m in read_bag(bag, {"planner/path"})]
+    assert paths, "no global path recorded"
+    assert all(path.points[-1].tolist() == goal for path in paths), paths[-1].points
+    targets = [decode(m.payload, PlannerState).target for m in read_bag(bag, {"planner/state"})]
+    assert len(targets) > 10 and all(abs(y - goal[1]) < 0.05 for _, y in targets), targets
+    poses = [decode(m.payload, Odometry).pose for m in read_bag(bag, {"odom"})]
+    assert poses[-1].x > scenario.robot.start[0] + 0.3, poses[-1]  # under way...
+    assert all(abs(p.y - goal[1]) < 0.05 for p in poses), \
+        min(p.y for p in poses)  # ...along y = 3, not turning for (6, 0)
 
 
 def test_schemas_go_where_the_readme_says(tmp_path: Path) -> None:

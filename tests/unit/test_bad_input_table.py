@@ -121,6 +121,11 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("ctl status with nothing up",
      lambda t: ["ctl", "--run-dir", str(t / "run"), "status"], 1,
      "zenav ctl: run is not up ({t}/run); start it with `zenav up`"),
+    ("ctl status --run-dir X, the option after the action",
+     lambda t: ["ctl", "status", "--run-dir", str(t / "run")], 1,
+     "zenav ctl: run is not up ({t}/run); start it with `zenav up`"),
+    ("ctl status --run-dir without its path", lambda t: ["ctl", "status", "--run-dir"], 2,
+     "zenav ctl: --run-dir: expected a path after it"),
     ("service --set an unknown parameter",
      lambda t: ["service", "perception", "--set", "nosuch=1"], 2,
      "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
@@ -166,3 +171,81 @@ def test_schemas_without_out_prints_every_schema_and_writes_nothing(
     printed = json.loads(capsys.readouterr().out)
     assert set(printed) == {m.TYPE for m in ALL_MESSAGES}
     assert list(tmp_path.iterdir()) == []
+
+
+def test_ctl_outside_the_repository_looks_in_the_default_stacks_run_directory(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """No deploy/stack.yaml in the current folder (an installed wheel): the default
+    deployment's run directory, not a complaint about the missing file."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("ZENAV_STATE_DIR", str(tmp_path / "state"))
+    assert zenav_main(["ctl", "status"]) == 1
+    assert capsys.readouterr().err.splitlines() == [
+        f"zenav ctl: stack is not up ({tmp_path / 'state' / 'stack'}); start it with "
+        "`zenav up`"]
+
+
+def test_several_limits_exceeded_are_one_line_each(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = scenario_with(tmp_path, "limits", laser={"resolution_deg": 0.025}, duration=30000,
+                         obstacles=[{"shape": "disc", "center": [1.0, 1.0], "radius": 0.05}]
+                         * (MAX_OBSTACLES + 1))
+    assert zenav_main(["run", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"zenav run: {path}: obstacles: at most {MAX_OBSTACLES} obstacles "
+        f"(got {MAX_OBSTACLES + 1})",
+        f"zenav run: {path}: laser.resolution_deg: at most 4000 beams per scan (got 7201: "
+        "fov_deg / resolution_deg + 1)",
+        f"zenav run: {path}: duration: at most 200000 simulator ticks (got 300000: duration "
+        "x max(laser.rate_hz, 10))",
+    ]
+
+
+PARAMS_PROBLEMS: list[tuple[str, Callable[[Path], list[str]], list[str]]] = [
+    # (case, argv, the lines on stderr)
+    ("a scenario with two mistakes",
+     lambda t: ["params", "planner", "--scenario",
+                str(scenario_with(t, "two", robot__speed=0, robot__radius=-0.2))],
+     ["zenav params: {t}/two.yaml: robot.speed: must be > 0 (got 0)",
+      "zenav params: {t}/two.yaml: robot.radius: must be > 0 (got -0.2)"]),
+    ("two bad --set", lambda t: ["params", "planner", "--set", "nosuch=1",
+                                 "--set", "cruise_speed=-1"],
+     ["zenav params: --set cruise_speed=-1: cruise_speed: Input should be greater than 0 "
+      "(got -1)",
+      "zenav params: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]),
+    ("a parameter file with two mistakes",
+     lambda t: ["params", "perception", "--params", str(a_params_file(t))],
+     ["zenav params: {t}/perception.yaml: lambda_: Input should be greater than 0 (got -1)",
+      "zenav params: {t}/perception.yaml: nosuch: Extra inputs are not permitted (got 1)"]),
+]
+
+
+def a_params_file(tmp: Path) -> Path:
+    path = tmp / "perception.yaml"
+    path.write_text("lambda_: -1\nnosuch: 1\n")
+    return path
+
+
+@pytest.mark.parametrize(("argv", "lines"), [row[1:] for row in PARAMS_PROBLEMS],
+                         ids=[row[0] for row in PARAMS_PROBLEMS])
+def test_params_names_each_problem_on_its_own_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: Args, lines: list[str]
+) -> None:
+    tmp = tmp_path.resolve()
+    assert zenav_main(argv(tmp)) == 2
+    assert capsys.readouterr().err.splitlines() == [line.format(t=tmp) for line in lines]
+
+
+def test_service_and_up_name_each_bad_set_on_its_own_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert zenav_main(["service", "perception", "--set", "nosuch=1", "--set", "lambda_=-1"]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "zenav perception: --set lambda_=-1: lambda_: Input should be greater than 0 (got -1)",
+        "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]
+    assert zenav_main(["up", "--print", "--run-dir", str(tmp_path / "run"), "--config",
+                       str(REPO / "deploy" / "stack.yaml"), "--set", "planner.nosuch=1",
+                       "--set", "tracking.nosuch=2"]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "zenav up: --set tracking.nosuch=2: nosuch: Extra inputs are not permitted (got 2)",
+        "zenav up: --set planner.nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]

@@ -59,7 +59,10 @@ def test_supervisord_conf_restarts_on_failure_logs_per_program_and_stops_cleanly
     priorities = [int(conf[f"program:{p}"]["priority"]) for p in programs]
     assert priorities == sorted(priorities) and priorities[0] == 10  # router first
     simulator = shlex.split(conf["program:simulator"]["command"])
-    assert simulator[:5] == ["/py", "-m", "zenav", "service", "simulator"]
+    # every program at the deployment's niceness (default -5): ahead of other work
+    assert simulator[:8] == ["nice", "-n", "-5", "/py", "-m", "zenav", "service", "simulator"]
+    assert all(shlex.split(conf[f"program:{p}"]["command"])[:3] == ["nice", "-n", "-5"]
+               for p in programs)
     assert "realtime_factor=4" in simulator
     assert f"scenario={deployment.scenario}" in simulator
     assert simulator[simulator.index("--transport") + 1] == str(tmp_path / "run" /
@@ -91,6 +94,7 @@ def test_a_program_may_be_any_command_standing_in_for_a_service(tmp_path):
     base["scenario"] = str(DEPLOY / base["scenario"])
     for spec in base["services"].values():
         spec["config"] = [str(DEPLOY / p) for p in spec["config"]]
+    base["supervisor"]["nice"] = -5
     base["services"]["planner_b"] = {
         "service": "planner", "autostart": False,
         "command": ["{python}", "my_planner.py", "--transport", "{transport}",
@@ -103,7 +107,8 @@ def test_a_program_may_be_any_command_standing_in_for_a_service(tmp_path):
     section = conf["program:planner_b"]
     assert section["autostart"] == "false" and section["priority"] == "70"
     assert shlex.split(section["command"].replace("%%", "%")) == [
-        "/py", "my_planner.py", "--transport", str(tmp_path / "run" / "transport.yaml"),
+        "nice", "-n", "-5", "/py", "my_planner.py", "--transport",
+        str(tmp_path / "run" / "transport.yaml"),
         "--robot-id", "robot0", "--value", "100%"]
     assert "100%%" in conf_text  # supervisord's expansion character is escaped
 
@@ -177,3 +182,43 @@ def test_the_control_socket_moves_to_tmp_when_the_run_directory_is_too_deep(tmp_
     moved = socket_path(deep)
     assert moved.parent == Path("/tmp") and moved == socket_path(deep)
     assert len(str(moved)) < 100
+
+
+def test_niceness_zero_runs_the_programs_as_they_are(tmp_path):
+    base = yaml.safe_load((DEPLOY / "stack.yaml").read_text())
+    base["scenario"] = str(DEPLOY / base["scenario"])
+    for spec in base["services"].values():
+        spec["config"] = [str(DEPLOY / p) for p in spec["config"]]
+    base["supervisor"]["nice"] = 0
+    path = tmp_path / "d.yaml"
+    path.write_text(yaml.safe_dump(base))
+    conf = conf_of(prepare(load_deployment(path), tmp_path / "run", python="/py"))
+    commands = [shlex.split(conf[s]["command"]) for s in conf.sections()
+                if s.startswith("program:")]
+    assert len(commands) == 7 and all(c[0] == "/py" for c in commands)
+
+
+def test_standby_pairs_every_service_and_the_router_with_a_warm_spare(tmp_path):
+    base = yaml.safe_load((DEPLOY / "stack.yaml").read_text())
+    base["scenario"] = str(DEPLOY / base["scenario"])
+    for spec in base["services"].values():
+        spec["config"] = [str(DEPLOY / p) for p in spec["config"]]
+    base["supervisor"]["standby"] = True
+    base["services"]["planner_b"] = {"service": "planner", "autostart": False,
+                                     "command": ["{python}", "my_planner.py"]}
+    path = tmp_path / "d.yaml"
+    path.write_text(yaml.safe_dump(base))
+    deployment = load_deployment(path)
+    conf = conf_of(prepare(deployment, tmp_path / "run", python="/py"))
+    programs = [s.removeprefix("program:") for s in conf.sections() if s.startswith("program:")]
+    served = ["router", "motor_bridge", "simulator", "laser_driver", "perception", "tracking",
+              "planner"]
+    assert [p for p in programs if p != "planner_b"] == [
+        p for name in served for p in (name, f"{name}_standby")]  # in start order
+    for name in served:
+        command = shlex.split(conf[f"program:{name}"]["command"])
+        assert command == shlex.split(conf[f"program:{name}_standby"]["command"])
+        assert command[-2:] == ["--standby-lock",
+                                str(tmp_path / "run" / "standby" / f"{name}.lock")]
+        assert conf[f"program:{name}"]["priority"] == conf[f"program:{name}_standby"]["priority"]
+    assert "--standby-lock" not in conf["program:planner_b"]["command"]

@@ -12,15 +12,23 @@ import xmlrpc.client
 from pathlib import Path
 from typing import Any
 
-from zenav.deploy.conf import default_run_dir, prepare, socket_path
+from zenav.deploy.conf import default_run_dir, prepare, socket_path, standby_twins
 from zenav.deploy.model import DEFAULT_CONFIG, Deployment, load_deployment
 from zenav.deploy.rpc import Supervisor, unclean_stops
 from zenav.deploy.wait import check_started, expected_alive, wait_alive, wait_running
 from zenav.services.config import ConfigError
 
+DEFAULT_NAME = "stack"
+"""The name of the default deployment (deploy/stack.yaml): ``zenav ctl`` and ``zenav down``
+without ``--config`` or ``--run-dir`` look in its run directory even where that file is not
+(outside the repository, with an installed wheel)."""
+
 
 def _resolve(args: argparse.Namespace) -> tuple[Deployment | None, Path]:
     deployment = None
+    if args.command != "up" and args.run_dir is None and args.config is None \
+            and not DEFAULT_CONFIG.exists():
+        return None, default_run_dir(DEFAULT_NAME).resolve()
     if args.run_dir is None or args.command == "up":
         config = args.config or DEFAULT_CONFIG
         if not config.exists():
@@ -73,6 +81,7 @@ def cmd_up(args: argparse.Namespace) -> int:
         programs = [p for p, s in deployment.services.items() if s.autostart]
         if deployment.router is not None:
             programs.insert(0, "router")
+        programs += standby_twins(deployment).values()
         wait_running(sup, programs, args.timeout)
         if not args.no_wait:
             missing = wait_alive(deployment, expected_alive(deployment), args.timeout,
@@ -134,7 +143,38 @@ def cmd_down(args: argparse.Namespace) -> int:
     return 0
 
 
+OWN_OPTIONS = ("--run-dir", "--config")
+"""``zenav ctl``'s own options, taken from anywhere on its command line: argparse hands
+everything after the first supervisorctl word (``status --run-dir X``) to supervisorctl."""
+
+
+def split_ctl_args(words: list[str]) -> tuple[dict[str, Path], list[str]] | str:
+    """(``zenav ctl``'s own options found among ``words``, the words for supervisorctl), or
+    the one-line problem (an option without its value)."""
+    own: dict[str, Path] = {}
+    rest: list[str] = []
+    items = iter(words)
+    for word in items:
+        name, equals, value = word.partition("=")
+        if name not in OWN_OPTIONS:
+            rest.append(word)
+            continue
+        if not equals:
+            value = next(items, "")
+        if not value or value.startswith("--"):
+            return f"{name}: expected a path after it"
+        own[name] = Path(value)
+    return own, rest
+
+
 def cmd_ctl(args: argparse.Namespace) -> int:
+    split = split_ctl_args(list(args.args))
+    if isinstance(split, str):
+        print(f"zenav ctl: {split}", file=sys.stderr)
+        return 2
+    own, args.args = split
+    args.run_dir = own.get("--run-dir", args.run_dir)
+    args.config = own.get("--config", args.config)
     if (resolved := _resolve_or_say(args)) is None:
         return 2
     deployment, run_dir = resolved
@@ -142,6 +182,11 @@ def cmd_ctl(args: argparse.Namespace) -> int:
     if sup.pid() is None:
         name = deployment.name if deployment else run_dir.name
         print(f"zenav ctl: {name} is not up ({run_dir}); start it with `zenav up`",
+              file=sys.stderr)
+        return 1
+    if not sup.ready():  # supervisorctl would print its own socket error
+        print(f"zenav ctl: supervisord (pid {sup.pid()}) is not answering on "
+              f"{socket_path(run_dir)}; see {run_dir / 'logs' / 'supervisord.log'}",
               file=sys.stderr)
         return 1
     return sup.ctl(list(args.args) or ["status"])

@@ -69,6 +69,25 @@ def scenario_params(deployment: Deployment) -> dict[str, dict[str, Any]]:
     return params
 
 
+STANDBY_SUFFIX = "_standby"
+
+
+def standby_twins(deployment: Deployment) -> dict[str, str]:
+    """Program -> the program name of its warm spare, when the deployment has standbys: the
+    router and every zenav service that starts with the deployment (a custom command is
+    not told about the lock)."""
+    if not deployment.supervisor.standby:
+        return {}
+    names = ["router"] if deployment.router is not None else []
+    names += [p for p, s in deployment.services.items() if s.command is None and s.autostart]
+    return {name: name + STANDBY_SUFFIX for name in names}
+
+
+def standby_lock(run_dir: Path, program: str) -> Path:
+    """The lock a program and its spare share: whoever holds it serves (its pid is in it)."""
+    return run_dir.resolve() / "standby" / f"{program}.lock"
+
+
 def program_command(deployment: Deployment, program: str, run_dir: Path,
                     derived: dict[str, Path], python: str) -> list[str]:
     spec = deployment.services[program]
@@ -195,9 +214,17 @@ def prepare(deployment: Deployment, run_dir: Path, python: str = sys.executable,
         priority = spec.priority or PRIORITY.get(deployment.service_of(program), CUSTOM_PRIORITY)
         programs.append((program, program_command(deployment, program, run_dir, derived, python),
                          spec.autostart, priority))
+    twins = standby_twins(deployment)
+    for i, (program, argv, autostart, priority) in enumerate(list(programs)):
+        if program in twins:
+            paired = [*argv, "--standby-lock", str(standby_lock(run_dir, program))]
+            programs[i] = (program, paired, autostart, priority)
+            programs.append((twins[program], paired, autostart, priority))
     programs.sort(key=lambda program: program[3])  # stable: the file's order within a rank
-    for program, command, autostart, priority in programs:
+    for program, argv, autostart, priority in programs:
         log = run_dir / "logs" / f"{program}.log"
+        # nice execs the program: supervisord's pid is still the program's
+        command = ["nice", "-n", str(sup.nice), *argv] if sup.nice != 0 else argv
         lines += [
             "",
             f"[program:{program}]",

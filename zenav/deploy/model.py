@@ -63,6 +63,14 @@ class SupervisorSpec(BaseModel):
     startsecs: int = Field(1, ge=0, description="s a program must stay up to count as started")
     startretries: int = Field(3, ge=0, description="failed starts in a row before FATAL")
     stopwaitsecs: int = Field(5, ge=1, description="s after SIGTERM before SIGKILL")
+    nice: int = Field(-5, ge=-20, le=19, description="scheduling niceness of every program "
+                      "(`nice -n`): below 0 the robot's processes, and above all a restarted "
+                      "one's start-up, go before other work on the host; needs root or "
+                      "CAP_SYS_NICE, else `nice` says so in the program's log and it runs at 0")
+    standby: bool = Field(False, description="beside the router and every zenav service, a "
+                          "warm spare (program NAME_standby) that has loaded everything and "
+                          "takes over the moment the serving process ends, kill -9 included; "
+                          "the process killed is restarted as the new spare")
     log_maxbytes: str = "10MB"
     log_backups: int = Field(3, ge=0)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import re
 import signal
 import sys
 import threading
@@ -18,9 +19,14 @@ from typing import Any
 
 import zenoh
 
-from zenav.schemas.keys import Keys, check_robot_id
 from zenav.services.config import ConfigError
-from zenav.services.runner import add_transport_arguments, setup_logging, transport_from_args
+from zenav.services.runner import (
+    add_standby_argument,
+    add_transport_arguments,
+    setup_logging,
+    take_over,
+    transport_from_args,
+)
 from zenav.services.transport import TransportConfig
 
 log = logging.getLogger(__name__)
@@ -37,10 +43,23 @@ def router_transport(args: argparse.Namespace) -> TransportConfig:
     return config.model_copy(update={"mode": "router"})
 
 
+ROBOT_ID = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+"""A robot id as :func:`zenav.schemas.keys.check_robot_id` accepts it (a test keeps the two
+equal): checked here without loading the message schemas, so that a restarted router
+listens again as soon as Python and Zenoh are up; its clients wait on it."""
+
+
+def token_key(robot_id: str) -> str:
+    """The router's liveliness token, ``Keys(robot_id).alive("router")`` spelled out."""
+    return f"zenav/{robot_id}/alive/router"
+
+
 def main(args: argparse.Namespace) -> int:
     setup_logging(args.log_level, "router")
     try:
-        keys = Keys(check_robot_id(args.robot_id))
+        if not ROBOT_ID.match(args.robot_id):
+            raise ValueError(f"robot id {args.robot_id!r} must be 1-64 letters, digits, '_' "
+                             "or '-' (it becomes part of every key)")
         transport = router_transport(args)
     except (ConfigError, ValueError) as exc:
         print(f"zenav router: {exc}", file=sys.stderr)
@@ -50,6 +69,11 @@ def main(args: argparse.Namespace) -> int:
     def on_signal(signum: int, frame: FrameType | None) -> None:
         stop.set()
 
+    if args.standby_lock is not None:
+        try:
+            take_over(args.standby_lock, "router")
+        except KeyboardInterrupt:
+            return 0
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, on_signal)
     try:
@@ -57,9 +81,10 @@ def main(args: argparse.Namespace) -> int:
     except Exception as exc:
         log.error("cannot open the router on %s: %s", ", ".join(transport.listen), exc)
         return 1
-    token = session.liveliness().declare_token(keys.alive("router"))
-    log.info("router up, listening on %s%s", ", ".join(transport.listen),
-             f", connected to {', '.join(transport.connect)}" if transport.connect else "")
+    token = session.liveliness().declare_token(token_key(args.robot_id))
+    joining = f", joining the routers at {', '.join(transport.connect)}" if transport.connect \
+        else ""
+    log.info("router up, listening on %s%s", ", ".join(transport.listen), joining)
     try:
         while not stop.wait(0.5):
             pass
@@ -75,4 +100,5 @@ def add_command(sub: Any) -> None:
                             "services and monitors)")
     router.add_argument("--log-level", default="INFO")
     add_transport_arguments(router)
+    add_standby_argument(router)
     router.set_defaults(func=main)

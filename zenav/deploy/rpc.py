@@ -7,6 +7,7 @@ import contextlib
 import os
 import subprocess
 import sys
+import time
 import xmlrpc.client
 from pathlib import Path
 from typing import Any
@@ -58,18 +59,27 @@ class Supervisor:
     def stop(self, program: str) -> None:
         self.proxy().supervisor.stopProcess(program, True)
 
-    def stop_in_order(self) -> list[str]:
+    def stop_in_order(self, timeout: float = 60.0) -> list[str]:
         """Stop every program that runs, highest priority number first (the planner before
-        the motor bridge, the router last), each fully before the next; their names."""
+        the motor bridge, the router last), each rank fully before the next; their names.
+        The programs of one rank stop together: a service and its warm spare (one SIGTERM
+        each), so that the spare does not take over from the one stopping."""
         proxy = self.proxy()
         priority = {c["name"]: c["process_prio"] for c in proxy.supervisor.getAllConfigInfo()}
         infos = self.processes()
-        stopped = []
-        for program in sorted(infos, key=lambda p: -priority.get(p, 0)):
-            if infos[program]["statename"] in ("RUNNING", "STARTING", "BACKOFF"):
+        stopped: list[str] = []
+        for rank in sorted({priority.get(p, 0) for p in infos}, reverse=True):
+            group = [p for p in sorted(infos) if priority.get(p, 0) == rank
+                     and infos[p]["statename"] in ("RUNNING", "STARTING", "BACKOFF")]
+            for program in group:
                 with contextlib.suppress(xmlrpc.client.Fault):  # it stopped meanwhile
-                    proxy.supervisor.stopProcess(program, True)
-                stopped.append(program)
+                    proxy.supervisor.stopProcess(program, False)
+            deadline = time.monotonic() + timeout
+            while group and time.monotonic() < deadline and any(
+                    info["statename"] in ("RUNNING", "STARTING", "BACKOFF", "STOPPING")
+                    for name, info in self.processes().items() if name in group):
+                time.sleep(0.02)
+            stopped += group
         return stopped
 
     def ctl(self, args: list[str]) -> int:
