@@ -29,6 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.geometry import wrap_angles
+from zenav.services.perception.clustering import to_global
+
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
@@ -45,10 +48,9 @@ class ScanSnapshot:
     range_max: float
 
     def points(self, beams: IntArray) -> FloatArray:
-        x, y, heading = self.pose
-        angle = heading + self.angle_min + self.angle_increment * beams
-        r = self.ranges[beams]
-        return np.column_stack([x + r * np.cos(angle), y + r * np.sin(angle)])
+        """(k, 2) global points of ``beams`` (Eq. 1, the one perception clusters with)."""
+        alpha = self.angle_min + beams * self.angle_increment
+        return np.column_stack(to_global(self.pose, self.ranges[beams], alpha))
 
 
 def seen_free(scan: ScanSnapshot, points: FloatArray, margin: float) -> npt.NDArray[np.bool_]:
@@ -57,8 +59,7 @@ def seen_free(scan: ScanSnapshot, points: FloatArray, margin: float) -> npt.NDAr
     x, y, heading = scan.pose
     dx, dy = points[:, 0] - x, points[:, 1] - y
     distance = np.hypot(dx, dy)
-    bearing = np.arctan2(dy, dx) - heading
-    bearing = np.arctan2(np.sin(bearing), np.cos(bearing))
+    bearing = wrap_angles(np.arctan2(dy, dx) - heading)
     beam = np.rint((bearing - scan.angle_min) / scan.angle_increment).astype(np.int64)
     n = scan.ranges.shape[0]
     inside = (beam >= 1) & (beam <= n - 2)

@@ -30,6 +30,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt
 
+from zenav.services.perception.clustering import to_global
+
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
 
@@ -145,9 +147,11 @@ class Costmap:
         self.now = max(self.now, stamp)
         x, y, heading = scan.pose
         ranges = np.asarray(scan.ranges, dtype=np.float64)
-        angles = heading + scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+        alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
         hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
-        ends = np.column_stack([x + ranges * np.cos(angles), y + ranges * np.sin(angles)])
+        ends = np.column_stack(to_global(scan.pose, ranges, alpha))  # Eq. 1
+        # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the robot).
+        ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
         self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
                      self.padding / 2)
         # Free space: every half cell along each beam, stopping half a cell short of
@@ -157,8 +161,8 @@ class Costmap:
         count = math.ceil(float(reach.max(initial=0.0)) / step) + 1
         s = np.arange(count) * step  # (k,)
         along = s[None, :] <= reach[:, None]  # (beams, k)
-        px = x + s[None, :] * np.cos(angles)[:, None]
-        py = y + s[None, :] * np.sin(angles)[:, None]
+        px = x + s[None, :] * ux[:, None]
+        py = y + s[None, :] * uy[:, None]
         free_points = np.column_stack([px[along], py[along]])
         cells = self.cell_of(free_points)
         cells = cells[self.inside(cells)]

@@ -16,11 +16,12 @@ from typing import Any
 import numpy as np
 import pytest
 
+from tests.planner.scans import scan_of
 from zenav.schemas.messages import LaserScan
-from zenav.services.perception import clustering
+from zenav.services.perception import clustering, motion_cue
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
-from zenav.services.planner import decide, morphin
+from zenav.services.planner import costmap, decide, morphin
 from zenav.services.planner.params import Params as PlannerParams
 from zenav.services.planner.prediction import Obstacle
 from zenav.services.tracking import correlation, tracker
@@ -96,6 +97,45 @@ def test_eq1_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
     spy = Spy(monkeypatch, clustering, "to_global")
     perceive([2.0, 2.0, 2.0])
     assert spy.calls >= 2  # the points, then the Eq. 5 centres
+
+
+def test_eq1_is_what_the_motion_cue_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The free-space motion test puts each scan's points in the global frame by Eq. 1
+    too (perception's node runs it on every scan, after the clustering)."""
+    spy = Spy(monkeypatch, motion_cue, "to_global")
+    perceive([2.0, 2.0, 2.0])
+    assert spy.calls == 1  # the window's points, once per scan
+
+
+def test_the_motion_cue_points_are_eq1() -> None:
+    # Robot at (1, 2) facing +y, beams 0 and 2 at alpha -90 and -89 degrees (0.5 degree
+    # step from -90): beam 0 at 2 m ends at (3, 2), beam 2 at 4 m at
+    # (1 + 4 cos 1 deg, 2 + 4 sin 1 deg) = (4.999391, 2.069810).
+    snap = motion_cue.ScanSnapshot(0.0, (1.0, 2.0, math.pi / 2), np.array([2.0, 9.0, 4.0]),
+                                   -math.pi / 2, HALF_DEG, 8.0)
+    assert snap.points(np.array([0, 2])) == pytest.approx(
+        np.array([[3.0, 2.0], [4.999391, 2.069810]]), abs=1e-6)
+
+
+def test_the_motion_cue_wraps_with_geometry(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The bearing of each earlier point is wrapped by the one wrap (geometry.py)."""
+    spy = Spy(monkeypatch, motion_cue, "wrap_angles")
+    perceiver = Perceiver(PAPER)
+    perceive([2.0, 2.0, 2.0], perceiver=perceiver)
+    perceive([2.0, 2.0, 2.0], stamp=1.0, perceiver=perceiver)
+    assert spy.calls >= 1
+
+
+def test_eq1_is_what_the_map_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The planner's occupancy map (beyond the paper) places each return by Eq. 1 too:
+    a wall 3 m ahead of a robot at (0, 0) facing +x is marked at x = 3."""
+    spy = Spy(monkeypatch, costmap, "to_global")
+    cm = costmap.Costmap((0.0, 0.0), (6.0, 0.0), resolution=0.1, decay=60.0, inflation=0.35,
+                         confirm=0.0, padding=2.0, max_size=100.0)
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=[(3.0, -1.0, 3.2, 1.0)]), 0.0)
+    assert spy.calls == 2  # the returns, and each beam's direction
+    i, j = cm.cell_of(np.array([[3.05, 0.0]]))[0]
+    assert int(cm.values()[i, j]) == costmap.OCCUPIED
 
 
 def test_eq1_is_what_tracking_calls_to_join_pieces(monkeypatch: pytest.MonkeyPatch) -> None:
