@@ -40,6 +40,10 @@ PROFILES: dict[str, dict[str, dict[str, Any]]] = {
         },
         "planner": {
             "threats_per_cycle": "one",  # Algorithm 1: the first threat, then break
+            # (e) when robot and crosser are at the PCP at the same time; the paper gives
+            # "the same time" no width: each is at the PCP while within the clearance of
+            # it, and the two intervals overlap (prediction.at_the_pcp_together).
+            "meet_rule": "same_time",
             # Algorithm 1's V_R - Delta V_R. The paper gives no Delta V_R: 0.02 m/s per
             # cycle takes V_R = 0.1 m/s to a stop in 5 scans (0.5 s at 10 Hz).
             "slow_step": 0.02,

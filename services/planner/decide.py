@@ -255,7 +255,7 @@ class Planner:
             horizons=[p.horizon * (1.25 if c is not None else 1.0) for c in held],
             following=[c is not None and c.letter == "g" for c in held],
             robot_radius=p.robot_radius, cell=p.cell, moving_speed=p.moving_speed,
-            head_on_cos=p.head_on_cos, same_way_cos=p.same_way_cos)
+            head_on_cos=p.head_on_cos, same_way_cos=p.same_way_cos, meet_rule=p.meet_rule)
 
     def _straight_ahead(self, robot: Vec, direction: Vec) -> float:
         """How far the global path runs on from the robot in ``direction`` before it

@@ -57,6 +57,12 @@ class Params(MissionParams, StopZoneParams):
         12.0, gt=0, description="longest time ahead a meeting with a mover is acted on, s: "
         "velocity errors grow with it, and the robot has time to answer a later one later"
     )
+    meet_rule: Literal["closest", "same_time"] = Field(
+        "closest", description="what makes a crosser a threat (e): closest (beyond the "
+        "paper): the footprints come within the clearance within the horizon; same_time (the "
+        "paper's): robot and crosser are at the PCP at the same time, each while within the "
+        "clearance of it, with no horizon (prediction.py)"
+    )
     head_on_cos: float = Field(
         -0.8, description="cos of the angle between motions below which a mover is head-on (f)"
     )

@@ -9,23 +9,41 @@ get there, and which of the paper's scenarios it is:
 - (b) a static obstacle on the path;
 - (c) a crosser that passes the PCP before the robot arrives;
 - (d) a crosser that arrives after the robot has passed;
-- (e) a crosser that would meet the robot at the PCP;
+- (e) a crosser that would meet the robot at the PCP (by ``meet_rule``, below);
 - (f) a mover coming head-on along the path;
 - (g) a slower mover ahead going the same way.
 
 (a) is the absence of all of these and (h) more than one threat at once; both are
 decided by the caller, which sees every obstacle.
+
+When a crosser is a threat (e) is the planner's ``meet_rule``:
+
+- ``closest`` (zenav's default, beyond the paper): the two footprints would come within
+  the clearance of each other within the horizon, wherever that happens;
+- ``same_time`` (the paper's): "the robot and the obstacle arrive at the crossing point
+  at the same time". The paper gives no width to "the same time"; here each of the two
+  is *at* the PCP while its centre is within the clearance (robot radius + obstacle
+  radius + margin) of it, which takes 2 clearance / speed, and they arrive at the same
+  time when those two intervals overlap from now on (:func:`at_the_pcp_together`). The
+  width thus follows from the footprints and the speeds, with no constant of its own:
+  a slow robot holds the crossing longer. The paper bounds the prediction by its window
+  only, so this rule has no horizon: a crosser in the window that will be at the PCP
+  with the robot is (e) however far ahead that is.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import ObstacleKind, ScenarioLetter
+
+MeetRule = Literal["closest", "same_time"]
+"""How a crosser is found to meet the robot (e); see the module notes."""
 
 Vec = npt.NDArray[np.float64]
 
@@ -64,6 +82,26 @@ def closest_approach(rel_pos: Vec, rel_vel: Vec, t_max: float) -> tuple[float, f
     speed2 = float(rel_vel @ rel_vel)
     t = 0.0 if speed2 < 1e-12 else min(max(-float(rel_pos @ rel_vel) / speed2, 0.0), t_max)
     return t, float(np.hypot(*(rel_pos + rel_vel * t)))
+
+
+def at_the_pcp_together(robot_distance: float, obstacle_distance: float, robot_speed: float,
+                        obstacle_speed: float, clearance: float, path_length: float) -> bool:
+    """The paper's (e): robot and obstacle at the PCP at the same time.
+
+    ``robot_distance`` and ``obstacle_distance``: how far each centre has to go along its
+    own path to the PCP (m, negative once past it). Each is at the PCP while within
+    ``clearance`` of it: the robot from (s - c) / v_R to (s + c) / v_R, the obstacle from
+    (q - c) / v_O to (q + c) / v_O (s from now). They meet when the two intervals overlap
+    after now, and the robot's path (``path_length`` m) reaches within the clearance of
+    the PCP. Touching intervals do not overlap (as the footprints that only touch do not
+    meet under ``closest``)."""
+    if robot_speed <= 0.0 or obstacle_speed <= 0.0 or robot_distance - clearance >= path_length:
+        return False
+    start = max((robot_distance - clearance) / robot_speed,
+                (obstacle_distance - clearance) / obstacle_speed, 0.0)
+    end = min((robot_distance + clearance) / robot_speed,
+              (obstacle_distance + clearance) / obstacle_speed)
+    return start < end
 
 
 def cell_squares(cells: tuple[int, int, int, int], cell: float) -> tuple[Vec, Vec]:
@@ -138,6 +176,7 @@ def assess_all(
     moving_speed: float,
     head_on_cos: float,
     same_way_cos: float,
+    meet_rule: MeetRule,
 ) -> list[Assessment]:
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
     per obstacle), the ones with something to do with the path, in order. The standing
@@ -165,7 +204,8 @@ def assess_all(
             a = assess(robot, direction, speed, path_length, ob, robot_radius=robot_radius,
                        margin=margins[i], cell=cell, horizon=horizons[i],
                        moving_speed=moving_speed, head_on_cos=head_on_cos,
-                       same_way_cos=same_way_cos, following=following[i])
+                       same_way_cos=same_way_cos, meet_rule=meet_rule,
+                       following=following[i])
         if a is not None:
             found.append(a)
     return found
@@ -185,10 +225,14 @@ def assess(
     moving_speed: float,
     head_on_cos: float,
     same_way_cos: float,
+    meet_rule: MeetRule,
     following: bool = False,
 ) -> Assessment | None:
     """Classify one obstacle against the robot going ``direction`` (unit) at ``speed``
     for ``path_length`` m; None when it has nothing to do with the robot's path.
+
+    ``meet_rule``: what makes a crosser a threat (e), see the module notes; the head-on
+    (f) and same-way (g) movers are threats by the closest approach under both rules.
 
     ``following``: the robot already follows this obstacle (g); it stays a threat while
     it is ahead in the robot's lane, however slowly the robot now closes in."""
@@ -234,6 +278,8 @@ def assess(
     robot_time = s / speed if speed > 0 else math.inf
     obstacle_time = q / obstacle_speed
     pcp_xy = (float(pcp[0]), float(pcp[1]))
+    if meet_rule == "same_time":
+        threat = at_the_pcp_together(s, q, speed, obstacle_speed, clearance, path_length)
     if threat:
         return Assessment(obstacle, "e", True, pcp_xy, s, robot_time, obstacle_time, gap, along,
                           along_speed, heading)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from zenav.schemas.messages import ObstacleKind
-from zenav.services.planner.prediction import Obstacle, assess, assess_all
+from zenav.services.planner.prediction import MeetRule, Obstacle, assess, assess_all
 
 KINDS: tuple[ObstacleKind, ...] = ("new", "static", "dynamic")
 
@@ -27,11 +27,12 @@ def random_obstacles(rng: np.random.Generator, count: int, cell: float) -> list[
     return found
 
 
-LETTERS: set[str] = set()
+LETTERS: dict[str, set[str]] = {"closest": set(), "same_time": set()}
 
 
+@pytest.mark.parametrize("meet_rule", ["closest", "same_time"])
 @pytest.mark.parametrize("seed", range(20))
-def test_all_at_once_is_one_by_one(seed: int) -> None:
+def test_all_at_once_is_one_by_one(seed: int, meet_rule: MeetRule) -> None:
     rng = np.random.default_rng(seed)
     cell = 0.25
     obstacles = random_obstacles(rng, 12, cell)
@@ -42,7 +43,7 @@ def test_all_at_once_is_one_by_one(seed: int) -> None:
     horizons = list(rng.uniform(4.0, 8.0, len(obstacles)))
     following = [bool(f) for f in rng.integers(0, 2, len(obstacles))]
     common = {"robot_radius": 0.3, "cell": cell, "moving_speed": 0.1, "head_on_cos": -0.9,
-              "same_way_cos": 0.9}
+              "same_way_cos": 0.9, "meet_rule": meet_rule}
     one_by_one = [a for i, ob in enumerate(obstacles)
                   if (a := assess(robot, direction, 0.8, 5.0, ob, margin=margins[i],
                                   horizon=horizons[i], following=following[i],
@@ -50,10 +51,12 @@ def test_all_at_once_is_one_by_one(seed: int) -> None:
     at_once = assess_all(robot, direction, 0.8, 5.0, obstacles, margins, horizons, following,
                          **common)
     assert at_once == one_by_one
-    LETTERS.update(a.letter for a in at_once)
+    LETTERS[meet_rule].update(a.letter for a in at_once)
 
 
-def test_the_worlds_cover_standing_and_moving_cases() -> None:
+@pytest.mark.parametrize("meet_rule", ["closest", "same_time"])
+def test_the_worlds_cover_standing_and_moving_cases(meet_rule: MeetRule) -> None:
     for seed in range(20):
-        test_all_at_once_is_one_by_one(seed)
-    assert {"b", "e"} <= LETTERS and LETTERS & {"c", "d", "f", "g"}
+        test_all_at_once_is_one_by_one(seed, meet_rule)
+    found = LETTERS[meet_rule]
+    assert {"b", "e"} <= found and found & {"c", "d", "f", "g"}

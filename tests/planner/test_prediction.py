@@ -18,7 +18,13 @@ import pytest
 from zenav.schemas.messages import ObstacleKind
 from zenav.services.planner.decide import Planner
 from zenav.services.planner.params import Params
-from zenav.services.planner.prediction import Assessment, Obstacle, assess
+from zenav.services.planner.prediction import (
+    Assessment,
+    MeetRule,
+    Obstacle,
+    assess,
+    at_the_pcp_together,
+)
 
 ROBOT = np.array([0.0, 0.0])
 EAST = np.array([1.0, 0.0])
@@ -33,9 +39,11 @@ def ob(position: tuple[float, float], velocity: tuple[float, float] = (0.0, 0.0)
                     cells=cells)
 
 
-def judge(obstacle: Obstacle, horizon: float = 12.0) -> Assessment | None:
+def judge(obstacle: Obstacle, horizon: float = 12.0,
+          meet_rule: MeetRule = "closest") -> Assessment | None:
     return assess(ROBOT, EAST, V_R, 6.0, obstacle, robot_radius=0.2, margin=0.1, cell=0.5,
-                  horizon=horizon, moving_speed=0.03, head_on_cos=-0.8, same_way_cos=0.8)
+                  horizon=horizon, moving_speed=0.03, head_on_cos=-0.8, same_way_cos=0.8,
+                  meet_rule=meet_rule)
 
 
 def heading(cos_phi: float) -> tuple[float, float]:
@@ -207,3 +215,118 @@ def test_off_the_path_and_behind_are_ignored() -> None:
     robot relate to nothing: None."""
     assert judge(ob((2.0, 1.0), kind="static", cells=(4, 4, 2, 2))) is None
     assert judge(ob((-2.0, 1.0), (0.0, 0.5))) is None
+
+
+# --- the paper's (e): at the PCP at the same time (meet_rule="same_time") ------------------
+# With the common set-up the clearance is c = 0.5 m. A crosser going +y at v_O from
+# (x0, -q) has its PCP at (x0, 0), s = x0 along the robot's path and q along its own. The
+# robot is at the PCP (within c of it) from (s - c) / V_R to (s + c) / V_R, that is
+# [10 s - 5, 10 s + 5]; the crosser from (q - c) / v_O to (q + c) / v_O. (e) when the two
+# overlap after now; otherwise (c) or (d) by the arrival times, as under "closest".
+
+
+def paper(obstacle: Obstacle, horizon: float = 12.0) -> Assessment | None:
+    return judge(obstacle, horizon, meet_rule="same_time")
+
+
+def test_same_time_e_as_the_paper_draws_it() -> None:
+    """From (1, -2) at 0.2 m/s: the robot at the PCP (1, 0) over [5, 15] s, the crosser
+    over [(2 - 0.5) / 0.2, (2 + 0.5) / 0.2] = [7.5, 12.5] s: they overlap, (e); both
+    centres arrive at 10 s. The same answer as "closest"."""
+    a = paper(ob((1.0, -2.0), (0.0, 0.2)))
+    assert a is not None and a.letter == "e" and a.threat
+    assert (a.robot_time, a.obstacle_time) == pytest.approx((10.0, 10.0))
+
+
+def test_same_time_c_and_d_by_hand() -> None:
+    """(c): from (3, -1) at 0.5 m/s, the crosser is at the PCP over [1, 3] s, the robot
+    over [25, 35] s: no overlap, the crosser first. (d): from (3, -5) at 0.1 m/s, the
+    crosser over [45, 55] s, after the robot has left at 35 s."""
+    c = paper(ob((3.0, -1.0), (0.0, 0.5)))
+    assert c is not None and c.letter == "c" and not c.threat
+    d = paper(ob((3.0, -5.0), (0.0, 0.1)))
+    assert d is not None and d.letter == "d" and not d.threat
+    assert (d.robot_time, d.obstacle_time) == pytest.approx((30.0, 50.0))
+
+
+def test_same_time_has_no_horizon() -> None:
+    """The crosser of the (d) case under "closest": from (3, -2) at 0.05 m/s it is at the
+    PCP over [(2 - 0.5) / 0.05, (2 + 0.5) / 0.05] = [30, 50] s, the robot over [25, 35] s:
+    they overlap over [30, 35] s, (e), although the closest approach (about 30 s ahead,
+    robot at (3.2, 0) and crosser at (3, -0.4) at 32 s: 0.447 m < 0.5) lies beyond the
+    12 s horizon, where "closest" calls it (d). Likewise the horizon case (1.42, -2.86) at
+    0.2 m/s: robot [9.2, 19.2] s, crosser [11.8, 16.8] s: (e) under the paper's rule."""
+    far = ob((3.0, -2.0), (0.0, 0.05))
+    closest = judge(far)
+    assert closest is not None and closest.letter == "d"
+    a = paper(far)
+    assert a is not None and a.letter == "e" and a.threat
+    assert (a.robot_time, a.obstacle_time) == pytest.approx((30.0, 40.0))
+    b = paper(ob((1.42, -2.86), (0.0, 0.2)))
+    assert b is not None and b.letter == "e"
+
+
+@pytest.mark.parametrize(("q", "letter"), [(1.99, "c"), (2.01, "e")])
+def test_same_time_the_crosser_leaves_as_the_robot_arrives(q: float, letter: str) -> None:
+    """From (3, -q) at 0.1 m/s the crosser leaves the PCP at (q + 0.5) / 0.1 s; the robot
+    arrives at (3 - 0.5) / 0.1 = 25 s. q = 1.99: gone at 24.9 s, (c) (there at 19.9 s,
+    before the robot's 30 s); q = 2.01: still there at 25 s (until 25.1 s), (e)."""
+    a = paper(ob((3.0, -q), (0.0, 0.1)))
+    assert a is not None and a.letter == letter and a.threat == (letter == "e")
+
+
+@pytest.mark.parametrize(("q", "letter"), [(3.99, "e"), (4.01, "d")])
+def test_same_time_the_crosser_arrives_as_the_robot_leaves(q: float, letter: str) -> None:
+    """From (3, -q) at 0.1 m/s the crosser arrives at (q - 0.5) / 0.1 s; the robot leaves
+    the PCP at (3 + 0.5) / 0.1 = 35 s. q = 3.99: arrives at 34.9 s, (e); q = 4.01: at
+    35.1 s, after the robot, (d) (centres at 30 s and 40.1 s)."""
+    a = paper(ob((3.0, -q), (0.0, 0.1)))
+    assert a is not None and a.letter == letter and a.threat == (letter == "e")
+
+
+def test_same_time_intervals_that_only_touch_do_not_meet() -> None:
+    """Robot 3 m and crosser 2 m from the PCP, both at 0.1 m/s, c = 0.5: the robot is
+    there over [25, 35] s, the crosser over [15, 25] s; they touch at 25 s only. Crosser
+    4 m away: [35, 45] s, touching at 35 s. 2.5 m away: [20, 30] s, they meet."""
+    assert not at_the_pcp_together(3.0, 2.0, 0.1, 0.1, 0.5, 6.0)
+    assert not at_the_pcp_together(3.0, 4.0, 0.1, 0.1, 0.5, 6.0)
+    assert at_the_pcp_together(3.0, 2.5, 0.1, 0.1, 0.5, 6.0)
+
+
+@pytest.mark.parametrize(("x0", "letter"), [(6.49, "e"), (6.51, None)])
+def test_same_time_the_pcp_within_reach_of_the_path(x0: float, letter: str | None) -> None:
+    """The path is 6 m long: the robot comes within c = 0.5 m of a PCP up to 6.5 m
+    along. A crosser from (x0, -x0) at 0.1 m/s is at the PCP over [10 x0 - 5, 10 x0 + 5]
+    s, exactly when the robot would be: x0 = 6.49 is (e) (6.49 - 0.5 = 5.99 < 6);
+    x0 = 6.51 is beyond the path's reach and its clearance: nothing to do with it."""
+    a = paper(ob((x0, -x0), (0.0, 0.1)))
+    assert (a.letter if a is not None else None) == letter
+
+
+def test_same_time_both_at_the_pcp_now() -> None:
+    """From (0.3, -0.2) at 0.2 m/s: the robot is 0.3 m from the PCP (0.3, 0), at it over
+    [-2, 8] s; the crosser over [(0.2 - 0.5) / 0.2, (0.2 + 0.5) / 0.2] = [-1.5, 3.5] s:
+    both there now, (e). A crosser already 0.6 m past it (from (0.3, 0.6)) is at it over
+    [-5.5, -0.5] s, all in the past: nothing to do with the robot."""
+    now = paper(ob((0.3, -0.2), (0.0, 0.2)))
+    assert now is not None and now.letter == "e"
+    assert paper(ob((0.3, 0.6), (0.0, 0.2))) is None
+
+
+def test_same_time_leaves_f_and_g_to_the_closest_approach() -> None:
+    """The head-on (f) and same-way (g) cases above give the same letters under the
+    paper's (e) rule: it decides crossers only."""
+    f = paper(ob((3.0, 0.0), (-0.3, 0.0)))
+    g = paper(ob((1.0, 0.0), (0.05, 0.0)))
+    assert f is not None and f.letter == "f" and g is not None and g.letter == "g"
+
+
+def test_the_paper_profile_answers_the_same_time_crosser() -> None:
+    """Through the planner: the (3, -2) crosser at 0.05 m/s is (e) with the paper profile's
+    meet_rule and left alone, (d), with zenav's."""
+    crosser = [ob((3.0, -2.0), (0.0, 0.05))]
+    zenav = Planner(PARAMS).step((0.0, 0.0, 0.0), crosser, stamp=1.0)
+    paper_rule = Planner(PARAMS.model_copy(update={"meet_rule": "same_time"})).step(
+        (0.0, 0.0, 0.0), crosser, stamp=1.0)
+    assert [a.letter for a in zenav.notes] == ["d"] and zenav.scenario == "a"
+    assert paper_rule.scenario == "e"
