@@ -1,11 +1,11 @@
-"""The whole pipeline in one process, without the bus: for debugging, benchmarks and tests.
+"""The pipeline's cores called directly, without the bus: for timing them.
 
 :class:`Pipeline` holds the pure cores the services call (laser driver -> perception ->
 tracking -> planner -> motor bridge), set up with the same parameters as ``zenav run``,
-and runs them on one scan at a time. :func:`run_inprocess` drives it with the simulator,
-so a lockstep run here follows the same trajectory as one through the processes.
-``zenav bench perf`` times it stage by stage with a :class:`StageClock`. The acceptance
-path is still ``zenav run``: this module skips the transport, the codec and the processes.
+and runs them on one scan at a time; ``zenav bench perf`` (its compute section) times it
+stage by stage with a :class:`StageClock`. It runs no scenario: a whole run in one
+process is the in-process engine's (:mod:`zenav.engine`, ``zenav run --engine
+inprocess``), which runs the services themselves.
 """
 
 from __future__ import annotations
@@ -13,38 +13,28 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any
 
 from typing_extensions import override
 
-from zenav.run import apply_override
 from zenav.schemas.messages import LaserScan, Pose2D, RawLaserFrame, Track, TrackList
 from zenav.services.laser_driver.params import Params as DriverParams
 from zenav.services.laser_driver.scan import frame_to_scan
-from zenav.services.mission import stack_params
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
 from zenav.services.planner.decide import Decision, Detour, Planner
-from zenav.services.planner.node import EventLog, EventRow, obstacles_of, scan_data
+from zenav.services.planner.node import obstacles_of, scan_data
 from zenav.services.planner.params import Params as PlannerParams
 from zenav.services.planner.prediction import Assessment, Obstacle
 from zenav.services.tracking.node import track_message
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Tracker
-from zenav.sim.params import Params as SimParams
-from zenav.sim.scenario import load_scenario
-from zenav.sim.simulation import Simulation
 
-StageTimes = dict[str, list[float]]
 Pose = tuple[float, float, float]
-
-STAGES = ("perception", "tracking", "planner")
-"""The stages a :class:`Pipeline` times on its clock, in order."""
 
 
 class StageClock:
@@ -140,64 +130,3 @@ class Pipeline:
         with self.clock.stage("planner"):
             decision = self.planner.step(pose, obstacles, t, scan_data(scan, pose))
         return Step(t, scan, clusters, tracks, track_list, obstacles, decision)
-
-
-def scenario_params(scenario_path: Path, overrides: list[str] | None = None
-                    ) -> dict[str, dict[str, Any]]:
-    """Each service's parameters for a scenario, as ``zenav run`` (paper planner) sets
-    them, with ``SERVICE.NAME=VALUE`` overrides."""
-    params = stack_params(load_scenario(scenario_path), scenario_path, "paper")
-    for text in overrides or []:
-        apply_override(params, text)
-    return params
-
-
-@dataclass
-class Cycle:
-    """What each stage produced for one scan."""
-
-    t: float
-    clusters: Clusters
-    tracks: list[Track]
-    decision: Decision
-    events: list[EventRow]
-
-
-@dataclass
-class InProcessRun:
-    simulation: Simulation
-    cycles: list[Cycle] = field(default_factory=list)
-    stage_seconds: StageTimes = field(default_factory=dict)
-    zone_stops: int = 0
-
-
-def run_inprocess(
-    scenario_path: Path,
-    overrides: list[str] | None = None,
-    on_cycle: Callable[[Cycle], None] | None = None,
-) -> InProcessRun:
-    params = scenario_params(scenario_path, overrides)
-    sim = Simulation(load_scenario(scenario_path), SimParams.model_validate(params["simulator"]))
-    pipeline = Pipeline(params)
-    log = EventLog(pipeline.planner_params.horizon)
-    run = InProcessRun(sim, stage_seconds={k: [] for k in STAGES})
-    v = omega = 0.0
-    seq = 0
-    while sim.outcome is None:
-        if sim.scan_due():
-            t, ranges, s = sim.t, sim.scan(), sim.state
-            pipeline.clock.reset()
-            step = pipeline.step(t, seq, ranges, (s.x, s.y, s.heading))
-            seq += 1
-            for stage in STAGES:
-                run.stage_seconds[stage].append(pipeline.clock.spent[stage])
-            v, omega, reason = pipeline.bridge.apply(step.t, step.decision.v,
-                                                     step.decision.omega, step.scan)
-            run.zone_stops += reason == "stop_zone"
-            cycle = Cycle(step.t, step.clusters, step.tracks, step.decision,
-                          log.events(step.decision))
-            run.cycles.append(cycle)
-            if on_cycle is not None:
-                on_cycle(cycle)
-        sim.step(v, omega)
-    return run

@@ -1,7 +1,8 @@
 """``zenav paper``: the paper's experiments through the real stack, as a report.
 
-Every run goes through ``zenav run``'s path (six processes over Zenoh, lockstep on the
-simulated clock). The report (``report.md``) puts the measured figures beside the
+Every run goes through ``zenav run``'s path: six processes over Zenoh, or with
+``--engine inprocess`` the same services in one process (lockstep on the simulated clock
+either way). The report (``report.md``) puts the measured figures beside the
 paper's and links the figures drawn from each run record; every number in it is
 computed from a ``run.json`` by :func:`indicators`.
 """
@@ -239,8 +240,32 @@ def accuracy_lines(quick: bool) -> list[str]:
     return lines
 
 
+def engine_lines(engine: str, verified: list[str], disagreements: list[str]) -> list[str]:
+    """How the runs were made, as the report's opening says it: with the in-process
+    engine, which runs were re-made through the stack and whether they agreed."""
+    if engine == "inprocess":
+        if not verified:
+            checked = " None was re-made through the stack."
+        elif not disagreements:
+            checked = (f" Re-made through the full stack, {', '.join(verified)} agreed with "
+                       "it tick by tick.")
+        else:
+            checked = (f" Re-made through the full stack, {len(disagreements)} of "
+                       f"{len(verified)} DISAGREED: {'; '.join(disagreements)}.")
+        return ["Times are simulated seconds. Every run went through the in-process engine",
+                "(`zenav run --engine inprocess`: the six services in one process on an",
+                "in-memory bus, every message through the codec, lockstep on the simulated",
+                f"clock); each number below is computed from that run's `run.json`.{checked}"]
+    return ["Times are simulated seconds. Every run went through the full service stack",
+            "(six processes over Zenoh on loopback, lockstep on the simulated clock); each",
+            "number below is computed from that run's `run.json` (in `runs/PROFILE/`)."]
+
+
 def write_report(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]],
-                 machine: str, wall: float, accuracy: list[str] | None = None) -> Path:
+                 machine: str, wall: float, accuracy: list[str] | None = None,
+                 engine: str = "stack", command: str = "",
+                 verified: tuple[list[str], list[str]] = ([], [])) -> Path:
+    """``verified``: the keys re-made through the stack and where any disagreed."""
     scenarios = {job.key: load_scenario(job.scenario) for job in jobs}
     seeds = tuple(s for s in SEEDS if any(k.endswith(f"seed{s}") for k in records))
     profiles = tuple(dict.fromkeys(job.profile for job in jobs))
@@ -248,15 +273,15 @@ def write_report(out: Path, jobs: list[Job], records: dict[str, dict[str, Any]],
     lines = [
         "# zenav: the paper's experiments",
         "",
-        f"Produced by `zenav paper --out {out}` on {machine} in {wall:.0f} s of wall time.",
-        "Times are simulated seconds. Every run went through the full service stack",
-        "(six processes over Zenoh on loopback, lockstep on the simulated clock); each",
-        "number below is computed from that run's `run.json` (in `runs/PROFILE/`).",
+        f"Produced by `{command or f'zenav paper --out {out}'}` on {machine} in {wall:.0f} s "
+        "of wall time.",
+        *engine_lines(engine, *verified),
         "",
         f"Profiles: {', '.join(PROFILE_TITLES.get(p, p) for p in profiles)}. The paper "
         "profile runs Section 3 as written (Eq. 3 alone, the decision tree and Eq. 15 "
-        "over T, Eq. 17's three terms, Algorithm 1's one threat per cycle and "
-        "V_R - dV_R); `zenav params NAME --profile paper` lists what it changes.",
+        "over T, (e) when robot and crosser reach the PCP at the same time, Eq. 17's three "
+        "terms, Algorithm 1's one threat per cycle and V_R - dV_R); `zenav params NAME "
+        "--profile paper` lists what it changes.",
         "",
         "## The eight scenarios: time to the goal",
         "",
@@ -355,8 +380,13 @@ def main(out: Path, quick: bool = False, parallel: int = 2,
         progress.update(task, advance=1, description="typing accuracy")
         accuracy = accuracy_lines(quick)
         progress.update(task, advance=1, description="report")
+    command = f"zenav paper --out {out}" + ("" if engine == "stack" else
+                                             f" --engine {engine} --verify {verify}")
+    if profiles != PROFILES:
+        command += f" --profile {profiles[0]}"
     return write_report(out, jobs, records, machine_description(), time.monotonic() - started,
-                        accuracy)
+                        accuracy, engine=engine, command=command + (" --quick" if quick else ""),
+                        verified=(records.verified, records.disagreements))
 
 
 def _command(args: argparse.Namespace) -> int:
