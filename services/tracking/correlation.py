@@ -248,8 +248,8 @@ def motion(now: tuple[float, float], before: tuple[float, float], period: float)
     dy = now[1] - before[1]
     d_o = math.hypot(dx, dy)  # Eq. 15, d_o
     heading = math.atan2(dy, dx)
-    # Eq. 15, alpha_o = arctan(dx / dy): from +y towards +x, full circle by atan2.
-    alpha_o = wrap_degrees(math.degrees(math.atan2(dx, dy)))
+    # Eq. 15, alpha_o = arctan(dx / dy): from +y towards +x, full circle (the heading's).
+    alpha_o = alpha_o_from_heading(heading)
     return Motion(
         v_o=d_o / period,  # Eq. 15, v_o
         alpha_o_deg=alpha_o,

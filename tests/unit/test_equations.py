@@ -354,6 +354,20 @@ def test_eq15_is_what_tracking_calls_in_paper_mode(monkeypatch: pytest.MonkeyPat
     assert tracks[0].speed == pytest.approx(1.0, rel=0.02)
 
 
+def test_eq15_direction_has_one_formula(monkeypatch: pytest.MonkeyPatch) -> None:
+    """alpha_o from a heading: 90 - degrees(heading), wrapped to [0, 360): +y is 0, +x 90,
+    -y 180 and -x 270. Eq. 15 (the paper's tracker) and the default tracker's velocity
+    both turn a heading into alpha_o through this one function."""
+    assert [correlation.alpha_o_from_heading(h) for h in
+            (math.pi / 2, 0.0, -math.pi / 2, math.pi)] == pytest.approx([0.0, 90.0, 180.0, 270.0])
+    spy = Spy(monkeypatch, correlation, "alpha_o_from_heading")
+    correlation.motion((1.0, 1.0), (0.0, 0.0), 0.5)
+    assert spy.calls == 1
+    in_tracker = Spy(monkeypatch, tracker, "alpha_o_from_heading")
+    track_two_frames("smoothed")
+    assert in_tracker.calls >= 1
+
+
 # --- Eq. 17 -------------------------------------------------------------------------
 
 
