@@ -43,13 +43,13 @@ def test_all_at_once_is_one_by_one(seed: int, meet_rule: MeetRule) -> None:
     horizons = list(rng.uniform(4.0, 8.0, len(obstacles)))
     following = [bool(f) for f in rng.integers(0, 2, len(obstacles))]
     common = {"robot_radius": 0.3, "cell": cell, "moving_speed": 0.1, "head_on_cos": -0.9,
-              "same_way_cos": 0.9, "meet_rule": meet_rule}
+              "same_way_cos": 0.9}
     one_by_one = [a for i, ob in enumerate(obstacles)
                   if (a := assess(robot, direction, 0.8, 5.0, ob, margin=margins[i],
                                   horizon=horizons[i], following=following[i],
-                                  **common)) is not None]
+                                  meet_rule=meet_rule, **common)) is not None]
     at_once = assess_all(robot, direction, 0.8, 5.0, obstacles, margins, horizons, following,
-                         **common)
+                         meet_rule=meet_rule, **common)
     assert at_once == one_by_one
     LETTERS[meet_rule].update(a.letter for a in at_once)
 
