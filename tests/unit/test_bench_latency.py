@@ -38,3 +38,15 @@ def test_the_table_has_one_row_per_service_and_the_target_verdict():
     assert "median ≤ 2 ms (met)" in text
     for name in STAGES:
         assert f"| {name} (" in text
+
+
+def test_lockstep_table_splits_the_command_and_judges_both_targets():
+    from zenav.bench.lockstep import LockstepRow, lockstep_table
+
+    rows = [LockstepRow("a", "reached", 60.0, 1.0, 2.5, 1.2),
+            LockstepRow("b", "reached", 40.0, 1.0, 2.5, 1.0)]
+    text = lockstep_table(rows)
+    # 100 simulated s in 2 s of loop (50x, met) and 5 s of command (20x, not met)
+    assert "| **all** | | 100.0 | 2.2 | 2.0 | **50.0** | 5.0 | **20.0** |" in text
+    assert "measured 50.0× (met)" in text
+    assert "measured 20.0× (NOT met)" in text
