@@ -19,21 +19,34 @@ def test_the_newest_sample_waits_in_zenoh_until_taken():
         sender = ZenohBus(TransportConfig(connect=[endpoint]), loop)
         try:
             newest = receiver.latest("zenav/robot0/odom")
+            marker = receiver.latest("zenav/robot0/marker")
             pub = sender.publisher("zenav/robot0/odom")
-            deadline = time.monotonic() + 10
-            got = None
-            while got is None and time.monotonic() < deadline:  # until the link is up
+            after = sender.publisher("zenav/robot0/marker")
+            # Until the link is up and the sender knows both subscriptions.
+            seen = {"odom": False, "marker": False}
+            deadline = time.monotonic() + 20
+            while not all(seen.values()) and time.monotonic() < deadline:
                 pub.put(b"probe")
+                after.put(b"probe")
                 await asyncio.sleep(0.05)
-                got = newest.take()
-            assert got == ("zenav/robot0/odom", b"probe")
-            await asyncio.sleep(0.2)
-            while newest.take() is not None:  # probes still on their way
-                await asyncio.sleep(0.05)
+                seen["odom"] |= newest.take() is not None
+                seen["marker"] |= marker.take() is not None
+            assert all(seen.values()), seen
+            await asyncio.sleep(0.5)  # probes still on their way
+            newest.take()
+            marker.take()
+            # The marker, sent after the three on the same link and priority, arrives
+            # after them: once it is in, all three have been received.
             for payload in (b"1", b"2", b"3"):
                 pub.put(payload)
-            await asyncio.sleep(0.3)
-            assert newest.take() == ("zenav/robot0/odom", b"3")
+            after.put(b"after")
+            deadline = time.monotonic() + 20
+            got = None
+            while got is None and time.monotonic() < deadline:
+                await asyncio.sleep(0.02)
+                got = marker.take()
+            assert got == ("zenav/robot0/marker", b"after")
+            assert newest.take() == ("zenav/robot0/odom", b"3")  # 1 and 2 were overwritten
             assert newest.take() is None
         finally:
             sender.close()
