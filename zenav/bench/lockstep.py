@@ -100,9 +100,11 @@ def lockstep_table(rows: list[LockstepRow]) -> str:
                  f"measured {fmt(factor, 1)}× ({verdict(factor >= TARGET_LOCKSTEP_FACTOR)}); "
                  f"≥ {TARGET_COMMAND_FACTOR:g}× for the whole command with the processes' start "
                  f"and stop — measured {sim / wall:.1f}× "
-                 f"({verdict(sim / wall >= TARGET_COMMAND_FACTOR)}). Start-up is from the "
-                 f"command's start to the simulator's loop starting (interpreter and imports of "
-                 f"seven processes, the Zenoh mesh, every service alive).")
+                 f"({verdict(sim / wall >= TARGET_COMMAND_FACTOR)}). The command's wall time is "
+                 f"run.json's (from the start of the run to the record, without the picture); "
+                 f"start-up is from the command's launch, its own interpreter included, to "
+                 f"the simulator's loop starting (seven interpreters and their imports, the "
+                 f"Zenoh mesh, every service alive).")
     return "\n".join(lines)
 
 
