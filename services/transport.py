@@ -107,12 +107,30 @@ class Subscription:
     def pending(self) -> int:
         return len(self._buffer)
 
+    def take(self) -> tuple[str, bytes] | None:
+        """The oldest buffered (key, payload), or None; never waits."""
+        return self._buffer.popleft() if self._buffer else None
+
     def close(self) -> None:
         self._closed = True
         self._ready.set()
         if self.on_close is not None:
             self.on_close()
             self.on_close = None
+
+
+class Latest(ABC):
+    """The newest sample of a key expression, for a consumer that looks now and then
+    (a tool checking progress) rather than handling every sample: nothing is scheduled
+    on the asyncio loop when a sample arrives, so a fast stream costs that process no
+    wake-up. Newest wins, one sample deep."""
+
+    @abstractmethod
+    def take(self) -> tuple[str, bytes] | None:
+        """The newest (key, payload) not taken yet, or None; never waits."""
+
+    @abstractmethod
+    def close(self) -> None: ...
 
 
 class Publisher(ABC):
@@ -145,6 +163,10 @@ class Bus(ABC):
 
     @abstractmethod
     def subscribe(self, key_expr: str, depth: int = 1) -> Subscription: ...
+
+    @abstractmethod
+    def latest(self, key_expr: str) -> Latest:
+        """The newest sample of ``key_expr``, held by the middleware until taken."""
 
     @abstractmethod
     def declare_token(self, key: str) -> Token:
@@ -184,6 +206,17 @@ class _MemoryPublisher(Publisher):
 
     def put(self, payload: bytes, attachment: bytes | None = None) -> None:
         self._bus.deliver(self._key, bytes(payload), attachment)
+
+
+class _MemoryLatest(Latest):
+    def __init__(self, sub: Subscription) -> None:
+        self._sub = sub
+
+    def take(self) -> tuple[str, bytes] | None:
+        return self._sub.take()
+
+    def close(self) -> None:
+        self._sub.close()
 
 
 class _MemoryToken(Token):
@@ -230,6 +263,9 @@ class InMemoryBus(Bus):
         sub.on_close = lambda: self._subs.remove(sub)
         return sub
 
+    def latest(self, key_expr: str) -> Latest:
+        return _MemoryLatest(self.subscribe(key_expr, depth=1))
+
     def declare_token(self, key: str) -> Token:
         self.set_alive(key, True)
         return _MemoryToken(self, key)
@@ -275,6 +311,24 @@ class _ZenohPublisher(Publisher):
 
     def put(self, payload: bytes, attachment: bytes | None = None) -> None:
         self._publisher.put(payload, attachment=attachment)
+
+
+class _ZenohLatest(Latest):
+    """A subscriber whose samples go into Zenoh's own one-deep ring channel: the
+    middleware keeps the newest, no Python code runs when one arrives."""
+
+    def __init__(self, subscriber: Any) -> None:
+        self._subscriber = subscriber
+
+    def take(self) -> tuple[str, bytes] | None:
+        sample = self._subscriber.try_recv()
+        if sample is None:
+            return None
+        return str(sample.key_expr), sample.payload.to_bytes()
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):  # already undeclared with the session
+            self._subscriber.undeclare()
 
 
 class _ZenohToken(Token):
@@ -332,6 +386,11 @@ class ZenohBus(Bus):
         handle = self._session.declare_subscriber(key_expr, on_sample)
         self._declared.append(handle)
         return sub
+
+    def latest(self, key_expr: str) -> Latest:
+        handle = self._session.declare_subscriber(key_expr, zenoh.handlers.RingChannel(1))
+        self._declared.append(handle)
+        return _ZenohLatest(handle)
 
     def declare_token(self, key: str) -> Token:
         token = self._session.liveliness().declare_token(key)

@@ -111,25 +111,28 @@ class Service:
             self.face.close()
 
     def publish_tick(self, with_scan: bool) -> None:
+        """Odometry, then the raw frame (the stack's answer starts from these two), then
+        the ground truth, which no service waits for."""
         odometry = self.sim.odometry(self.odom.next_seq())
-        self.truth.publish(self.sim.truth(self.truth.next_seq()))
         if self.face is not None:
             self.face.publish_odometry(odometry)
             if with_scan:
                 self.face.publish_scan(self.sim.t, self.sim.scan())
-            return
-        self.odom.publish(odometry)
-        if with_scan:
-            ranges = self.sim.scan()
-            self.raw.publish(RawLaserFrame(stamp=self.sim.t, seq=self.raw.next_seq(),
-                                           ranges=ranges))
+        else:
+            self.odom.publish(odometry)
+            if with_scan:
+                ranges = self.sim.scan()
+                self.raw.publish(RawLaserFrame(stamp=self.sim.t, seq=self.raw.next_seq(),
+                                               ranges=ranges))
+        self.truth.publish(self.sim.truth(self.truth.next_seq()))
 
     async def await_answer(self) -> None:
         """Lockstep: wait for the base command stamped with this tick, resending if needed."""
         waited = 0.0
         while not self._answered.is_set():
-            try:
-                await asyncio.wait_for(self._answered.wait(), self.params.retransmit_after)
+            try:  # a timer on this task, not a task of its own per tick as wait_for makes
+                async with asyncio.timeout(self.params.retransmit_after):
+                    await self._answered.wait()
             except TimeoutError:
                 waited += self.params.retransmit_after
                 if waited >= self.params.answer_timeout:

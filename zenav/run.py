@@ -34,7 +34,7 @@ from zenav.services.mission import stack_params
 from zenav.services.profiles import DEFAULT_PROFILE, apply_profile
 from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
 from zenav.services.runner import PLANNERS, service_params
-from zenav.services.transport import ZenohBus
+from zenav.services.transport import Latest, Subscription, ZenohBus
 from zenav.sim.scenario import load_scenario
 
 
@@ -166,9 +166,12 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         # the history query alone can miss them when it times out on a loaded machine.
         results = bus.subscribe(k.of(keys.RESULT), depth=1)
         events_sub = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
-        odom = bus.subscribe(k.of(keys.ODOM), depth=1)
+        # Odometry (every tick) and the map are only looked at between two checks: Zenoh
+        # keeps the newest of each, and this process is not woken for them. Paths are
+        # rare and each one is kept.
+        odom = bus.latest(k.of(keys.ODOM))
         paths = bus.subscribe(k.of(keys.PATH), depth=PATHS_KEPT)
-        maps = bus.subscribe(k.of(keys.MAP), depth=1)
+        maps = bus.latest(k.of(keys.MAP))
         token = bus.declare_token(k.alive("run"))
         events: list[PlannerEvent] = []
         last_progress = time.monotonic()
@@ -183,29 +186,21 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
                 result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
             except (TimeoutError, DecodeError):
                 pass
-            while paths.pending():
-                with contextlib.suppress(DecodeError):
-                    heard.path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
-                                        keys.PATH.max_bytes)
-                    heard.paths.append(heard.path)
-            while maps.pending():
-                with contextlib.suppress(DecodeError):
-                    heard.occupancy = decode((await maps.get())[1], OccupancyMap,
-                                             k.of(keys.MAP), keys.MAP.max_bytes)
-            while odom.pending():
-                _, payload = await odom.get()
+            await _take_paths_and_map(k, paths, maps, heard)
+            newest = odom.take()
+            if newest is not None:
                 try:
-                    stamp = decode(payload, Odometry, k.of(keys.ODOM)).stamp
+                    stamp = decode(newest[1], Odometry, k.of(keys.ODOM)).stamp
                 except DecodeError:
-                    continue  # not ours to judge; the services count it
-                if stamp > sim_time + 3600:
-                    continue  # a stamp from nowhere does not prove progress
-                if stamp > sim_time:
+                    stamp = -math.inf  # not ours to judge; the services count it
+                # a stamp from nowhere (an hour ahead) does not prove progress
+                if sim_time < stamp <= sim_time + 3600:
                     sim_time, last_progress = stamp, time.monotonic()
             if time.monotonic() - last_progress > progress_timeout:
                 where = "before the first tick" if sim_time < 0 else f"at t={sim_time:.2f} s"
                 raise RunError(f"the simulation made no progress for {progress_timeout:.0f} s "
                                 f"{where}; see the logs in {stack.out_dir / 'logs'}")
+        await _take_paths_and_map(k, paths, maps, heard)  # those sent before the result
         # The planner keeps every event it made; asking for them all does not depend on
         # this process having been subscribed before the first one.
         history = await bus.query(k.of(keys.EVENT_HISTORY), timeout=5.0)
@@ -227,6 +222,21 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         if recording is not None:
             recording.close()
         bus.close()
+
+
+async def _take_paths_and_map(k: Keys, paths: Subscription, maps: Latest,
+                              heard: Heard) -> None:
+    """Every path and the newest map that came since the last look, into ``heard``."""
+    while paths.pending():
+        with contextlib.suppress(DecodeError):
+            heard.path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
+                                keys.PATH.max_bytes)
+            heard.paths.append(heard.path)
+    occupancy = maps.take()
+    if occupancy is not None:
+        with contextlib.suppress(DecodeError):
+            heard.occupancy = decode(occupancy[1], OccupancyMap, k.of(keys.MAP),
+                                     keys.MAP.max_bytes)
 
 
 class _Recording:

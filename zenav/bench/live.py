@@ -22,13 +22,19 @@ from zenav.tooling import SampleCallback, StampedSubscriber, ThreadedBus
 
 class Listener:
     """The bench's own tool on the stack's bus: the wall receive time (taken in Zenoh's
-    callback) of every scan, velocity command and base command by stamp, and the latest
-    status per service. Its liveliness token ``bench`` is up once it listens."""
+    callback) of every scan, velocity command and base command by stamp (with ``hops``,
+    of every message of the scan's path: also the raw frame, the obstacle chain and the
+    track list), and the latest status per service. Its liveliness token ``bench`` is up
+    once it listens."""
 
-    def __init__(self, stack: Stack) -> None:
+    def __init__(self, stack: Stack, hops: bool = False) -> None:
         self.k = Keys(stack.robot_id)
+        self.hops = hops
         self.lock = threading.Lock()
+        self.frames: dict[float, float] = {}
         self.scans: dict[float, float] = {}
+        self.chains: dict[float, float] = {}
+        self.tracks: dict[float, float] = {}
         self.commands: dict[float, float] = {}
         self.base: dict[float, float] = {}
         self.status: dict[str, ServiceStatus] = {}
@@ -38,11 +44,24 @@ class Listener:
     def _listen(self) -> list[StampedSubscriber]:
         bus = self._bus.bus
         subscribers = [StampedSubscriber(bus, self.k.of(topic), self._stamped(topic, into))
-                       for topic, into in ((keys.SCAN, self.scans), (keys.CMD_VEL, self.commands),
-                                           (keys.BASE_CMD, self.base))]
+                       for topic, into in self.path()
+                       if self.hops or topic in (keys.SCAN, keys.CMD_VEL, keys.BASE_CMD)]
         subscribers.append(StampedSubscriber(bus, self.k.status_any, self._status))
         bus.declare_token(self.k.alive("bench"))
         return subscribers
+
+    def path(self) -> tuple[tuple[Topic, dict[float, float]], ...]:
+        """The topics of the scan's path through the stack, in order, each with the
+        receive times by stamp."""
+        return ((keys.RAW_LASER, self.frames), (keys.SCAN, self.scans),
+                (keys.OBSTACLES, self.chains), (keys.TRACKS, self.tracks),
+                (keys.CMD_VEL, self.commands), (keys.BASE_CMD, self.base))
+
+    def clear(self) -> None:
+        """Forget every receive time so far (the start of a measured window)."""
+        with self.lock:
+            for _, into in self.path():
+                into.clear()
 
     def _stamped(self, topic: Topic, into: dict[float, float]) -> SampleCallback:
         def on_sample(key: str, payload: bytes, received_ns: int) -> None:
@@ -76,10 +95,11 @@ class Listener:
 
 
 @contextlib.contextmanager
-def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str, Any]]
-               ) -> Iterator[tuple[Stack, Listener]]:
-    """A real-time stack on ``scenario_path`` with the bench listening; the simulator's
-    clock starts once the bench's liveliness token is up."""
+def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str, Any]],
+               hops: bool = False) -> Iterator[tuple[Stack, Listener]]:
+    """A real-time stack on ``scenario_path`` with the bench listening (``hops``: to
+    every message of the scan's path); the simulator's clock starts once the bench's
+    liveliness token is up."""
     scenario = load_scenario(scenario_path)
     params = stack_params(scenario, scenario_path, "paper")
     params["simulator"].update(clock="realtime",
@@ -92,7 +112,7 @@ def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str
     stack.start()
     listener: Listener | None = None
     try:
-        listener = Listener(stack)
+        listener = Listener(stack, hops)
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             failure = stack.failure()
