@@ -51,6 +51,13 @@ class ScanData:
     range_min: float = 0.0
 
 
+def _flat(grid: npt.NDArray[np.generic]) -> npt.NDArray[np.generic]:
+    """A flat view of a grid (never a copy: the grids are C-contiguous)."""
+    flat = grid.reshape(-1)
+    assert flat.base is grid or flat.base is grid.base
+    return flat
+
+
 class Costmap:
     """Occupancy from the scans, with decay; inflated on demand."""
 
@@ -82,8 +89,9 @@ class Costmap:
         self.hit_since = np.full((nx, ny), math.inf)  # start of its current occupied spell
         self.now = -math.inf
         self.version = 0  # bumped whenever the occupied set may have changed
-        self._inflated: tuple[int, BoolGrid, BoolGrid] | None = None
+        self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None
+        self._scratch = np.empty(0)  # reused by the ray tracing
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -114,8 +122,11 @@ class Costmap:
         nx, ny = self.shape
         lo = np.min(points, axis=0) - margin
         hi = np.max(points, axis=0) + margin
-        add_lo = np.maximum(np.ceil((self.origin - lo) / self.padding), 0) * self.padding
         top = self.origin + np.array([nx, ny]) * r
+        if (self.origin[0] <= lo[0] and self.origin[1] <= lo[1] and hi[0] <= top[0]
+                and hi[1] <= top[1]):
+            return  # inside already (what the growth below would find, cheaper)
+        add_lo = np.maximum(np.ceil((self.origin - lo) / self.padding), 0) * self.padding
         add_hi = np.maximum(np.ceil((hi - top) / self.padding), 0) * self.padding
         if not (add_lo.any() or add_hi.any()):
             return
@@ -155,20 +166,33 @@ class Costmap:
         self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
                      self.padding / 2)
         # Free space: every half cell along each beam, stopping half a cell short of
-        # its return (a beam with no return clears up to its reach).
+        # its return (a beam with no return clears up to its reach). Only the set of
+        # cells matters, so they are found as flat indices, computed per axis with the
+        # same arithmetic as ``cell_of`` (bit for bit the same cells).
         step = self.resolution / 2
         reach = np.where(hit, ranges - step, ranges)
         count = math.ceil(float(reach.max(initial=0.0)) / step) + 1
         s = np.arange(count) * step  # (k,)
         along = s[None, :] <= reach[:, None]  # (beams, k)
-        px = x + s[None, :] * ux[:, None]
-        py = y + s[None, :] * uy[:, None]
-        free_points = np.column_stack([px[along], py[along]])
-        cells = self.cell_of(free_points)
-        cells = cells[self.inside(cells)]
-        self.seen[cells[:, 0], cells[:, 1]] = stamp
-        cleared = self.occupied[cells[:, 0], cells[:, 1]]
-        self.occupied[cells[:, 0], cells[:, 1]] = False
+        nx, ny = self.shape
+        shape = along.shape
+        if self._scratch.size < 2 * along.size:
+            self._scratch = np.empty(2 * along.size)
+        fx = self._scratch[:along.size].reshape(shape)
+        fy = self._scratch[along.size:2 * along.size].reshape(shape)
+        self._axis_cells(fx, x, s, ux, 0)
+        self._axis_cells(fy, y, s, uy, 1)
+        along &= fx >= 0
+        along &= fx < nx
+        along &= fy >= 0
+        along &= fy < ny
+        fx *= ny
+        fx += fy  # the flat index, exact: whole numbers far below 2**53
+        flat = fx[along].astype(np.intp)
+        seen, occupied = _flat(self.seen), _flat(self.occupied)
+        seen[flat] = stamp
+        cleared = occupied[flat]
+        occupied[flat] = False
         # Hits, except those on a mover.
         marks = ends[hit]
         if movers and len(marks):
@@ -184,7 +208,15 @@ class Costmap:
         self.occupied[hits[:, 0], hits[:, 1]] = True
         if cleared.any() or newly.any() or self.confirm > 0:
             self.version += 1
-            self._inflated = None
+
+    def _axis_cells(self, out: Vec, x: float, s: Vec, cos: Vec, axis: int) -> None:
+        """The cell index along ``axis``, as a whole float, of every sample
+        ``x + s * cos`` of every beam (the arithmetic of :meth:`cell_of`, in place)."""
+        np.multiply.outer(cos, s, out=out)
+        out += x
+        out -= self.origin[axis]
+        out /= self.resolution
+        np.floor(out, out=out)
 
     def forget_older_than(self, stamp: float) -> None:
         """Make every cell last seen before ``stamp`` unknown (recovery's clearing)."""
@@ -209,18 +241,18 @@ class Costmap:
 
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
         lethal = self.lethal()
-        key = int(self.version)
-        # Decay changes the lethal set without an update: compare the set itself.
-        if self._inflated is not None and self._inflated[0] == key and np.array_equal(
-                self._inflated[1], lethal):
-            return self._inflated[1], self._inflated[2]
+        # The inflation depends on the lethal set alone: compare the set itself (decay
+        # and confirmation change it without an update, and an update with confirmation
+        # bumps the version on every scan though the set mostly stays the same).
+        if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
+            return self._inflated
         if lethal.any():
             gap = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * self.resolution
             blocked = np.asarray(gap <= self.inflation)
         else:
             gap = np.full(lethal.shape, math.inf)
             blocked = np.zeros_like(lethal)
-        self._inflated = (key, lethal, blocked)
+        self._inflated = (lethal, blocked)
         self._gap = gap
         return lethal, blocked
 
