@@ -68,6 +68,72 @@ def seen_free(scan: ScanSnapshot, points: FloatArray, margin: float) -> npt.NDAr
     return np.asarray(inside & (reach > distance + margin))
 
 
+@dataclass(frozen=True)
+class ClusterPoints:
+    """The current scan's clustered window points, as every comparison with an earlier
+    scan needs them: computed once per scan, whatever the number of baselines."""
+
+    n: int  # clusters
+    member: IntArray  # cluster of each point
+    points: FloatArray  # (k, 2) global points of the clustered window beams
+    counts: IntArray  # (n,) points per cluster
+    lo: FloatArray  # (n, 2) each cluster's bounding box, widened by ``reach``
+    hi: FloatArray
+
+
+def cluster_points(current: ScanSnapshot, cluster_beams: IntArray, window_beams: IntArray,
+                   reach: float, window_points: FloatArray | None = None
+                   ) -> ClusterPoints | None:
+    """The clustered points of ``current`` (None when no cluster has a window beam)."""
+    n = len(cluster_beams)
+    if n == 0 or len(window_beams) == 0:
+        return None
+    # Which cluster each window beam belongs to (-1: none), in one pass.
+    owner = np.full(current.ranges.shape[0], -1, dtype=np.int64)
+    for k, (first, last) in enumerate(cluster_beams):
+        owner[first: last + 1] = k
+    owned = owner[window_beams] >= 0
+    beams = window_beams[owned]
+    if len(beams) == 0:
+        return None
+    member = owner[beams]
+    points = (current.points(beams) if window_points is None else window_points[owned])
+    counts = np.bincount(member, minlength=n)
+    lo = np.full((n, 2), np.inf)
+    hi = np.full((n, 2), -np.inf)
+    # Each cluster's bounding box: its points grouped by cluster, then one min and
+    # one max per group (exact, as np.minimum.at would give, without its slow path).
+    order = np.argsort(member, kind="stable")
+    grouped, ordered = member[order], points[order]
+    starts = np.flatnonzero(np.r_[True, grouped[1:] != grouped[:-1]])
+    lo[grouped[starts]] = np.minimum.reduceat(ordered, starts, axis=0)
+    hi[grouped[starts]] = np.maximum.reduceat(ordered, starts, axis=0)
+    lo -= reach
+    hi += reach
+    return ClusterPoints(n, member, points, counts, lo, hi)
+
+
+def scores_against(clustered: ClusterPoints, current: ScanSnapshot, past: ScanSnapshot,
+                   past_points: FloatArray, margin: float) -> FloatArray:
+    """(n,) score in [0, 1] per cluster of ``clustered`` against the earlier scan
+    ``past`` (``past_points``: the global points of its window beams)."""
+    n, member = clustered.n, clustered.member
+    counts = clustered.counts
+    entered = np.bincount(member, weights=seen_free(past, clustered.points, margin),
+                          minlength=n)
+    scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
+    if len(past_points) >= 2:
+        vacated = seen_free(current, past_points, margin)
+        lo, hi = clustered.lo, clustered.hi
+        near = np.all((past_points[:, None, :] >= lo[None]) & (past_points[:, None, :] <= hi[None]),
+                      axis=2)  # (past points, clusters)
+        n_near = near.sum(axis=0)
+        gone = (near & vacated[:, None]).sum(axis=0)
+        share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
+        scores = np.maximum(scores, share)
+    return scores
+
+
 def motion_scores(
     current: ScanSnapshot,
     cluster_beams: IntArray,
@@ -87,45 +153,12 @@ def motion_scores(
     ``window_points`` and ``past_points``: the global points of ``window_beams`` and
     ``past_beams`` when the caller has them already (:class:`MotionCue` keeps them).
     """
-    n = len(cluster_beams)
-    scores = np.zeros(n)
-    if n == 0 or len(window_beams) == 0:
-        return scores
-    # Which cluster each window beam belongs to (-1: none), in one pass.
-    owner = np.full(current.ranges.shape[0], -1, dtype=np.int64)
-    for k, (first, last) in enumerate(cluster_beams):
-        owner[first: last + 1] = k
-    owned = owner[window_beams] >= 0
-    beams = window_beams[owned]
-    if len(beams) == 0:
-        return scores
-    member = owner[beams]
-    points = (current.points(beams) if window_points is None else window_points[owned])
-    counts = np.bincount(member, minlength=n)
-    entered = np.bincount(member, weights=seen_free(past, points, margin), minlength=n)
-    scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
-    if len(past_beams) >= 2:
-        if past_points is None:
-            past_points = past.points(past_beams)
-        vacated = seen_free(current, past_points, margin)
-        lo = np.full((n, 2), np.inf)
-        hi = np.full((n, 2), -np.inf)
-        # Each cluster's bounding box: its points grouped by cluster, then one min and
-        # one max per group (exact, as np.minimum.at would give, without its slow path).
-        order = np.argsort(member, kind="stable")
-        grouped, ordered = member[order], points[order]
-        starts = np.flatnonzero(np.r_[True, grouped[1:] != grouped[:-1]])
-        lo[grouped[starts]] = np.minimum.reduceat(ordered, starts, axis=0)
-        hi[grouped[starts]] = np.maximum.reduceat(ordered, starts, axis=0)
-        lo -= reach
-        hi += reach
-        near = np.all((past_points[:, None, :] >= lo[None]) & (past_points[:, None, :] <= hi[None]),
-                      axis=2)  # (past points, clusters)
-        n_near = near.sum(axis=0)
-        gone = (near & vacated[:, None]).sum(axis=0)
-        share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
-        scores = np.maximum(scores, share)
-    return scores
+    clustered = cluster_points(current, cluster_beams, window_beams, reach, window_points)
+    if clustered is None:
+        return np.zeros(len(cluster_beams))
+    if past_points is None:
+        past_points = past.points(past_beams) if len(past_beams) >= 2 else np.empty((0, 2))
+    return scores_against(clustered, current, past, past_points, margin)
 
 
 class MotionCue:
@@ -161,13 +194,15 @@ class MotionCue:
         points = scan.points(window)  # once per scan, kept for the scans after it
         scores = np.zeros((len(cluster_beams), len(self.baselines)))
         stamps = np.full(len(self.baselines), np.nan)
+        # The clusters' points and boxes once, for every baseline.
+        clustered = cluster_points(scan, cluster_beams, window, self.reach, points)
         for j, baseline in enumerate(self.baselines):
             past = self._at_least(scan.stamp - baseline)
             if past is not None:
                 stamps[j] = past[0].stamp
-                scores[:, j] = motion_scores(scan, cluster_beams, window, past[0], past[1],
-                                             self.margin, self.reach, window_points=points,
-                                             past_points=past[2])
+                if clustered is not None:
+                    scores[:, j] = scores_against(clustered, scan, past[0], past[2],
+                                                  self.margin)
         self._scans.append((scan, window, points))
         oldest = scan.stamp - self.baselines[-1] - 1.0
         while len(self._scans) > 1 and self._scans[1][0].stamp <= oldest:
