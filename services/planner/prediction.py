@@ -184,7 +184,7 @@ def assess_all(
     grid area's gaps in one array operation (element by element the same arithmetic as
     :func:`assess`, so the same answers to the last bit)."""
     standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
-    gaps: dict[int, Vec] = {}
+    gaps: dict[int, Vec | None] = {}  # standing obstacles' gaps; None: clear of the path
     if standing:
         points = path_points(robot, direction, path_length, cell / 4)
         cells = np.array([obstacles[i].cells for i in standing], dtype=np.float64)
@@ -194,12 +194,18 @@ def assess_all(
         above = points[:, None, :] - highs[None, :, :]
         outside = np.maximum(np.maximum(below, above), 0.0)
         distance = np.hypot(outside[..., 0], outside[..., 1])  # (points, boxes)
+        clearance = np.array([robot_radius + margins[i] for i in standing], dtype=np.float64)
+        every = distance - clearance[None, :]
+        # Only a box with a negative gap somewhere is on the path (b): one test for all.
+        touching = (every < 0).any(axis=0)
         for column, i in enumerate(standing):
-            gaps[i] = distance[:, column] - (robot_radius + margins[i])
+            gaps[i] = every[:, column] if touching[column] else None
     found = []
     for i, ob in enumerate(obstacles):
         if i in gaps:
-            a = _on_the_path(robot, direction, speed, path_length, ob, gaps[i])
+            column_gaps = gaps[i]
+            a = (None if column_gaps is None else
+                 _on_the_path(robot, direction, speed, path_length, ob, column_gaps))
         else:
             a = assess(robot, direction, speed, path_length, ob, robot_radius=robot_radius,
                        margin=margins[i], cell=cell, horizon=horizons[i],
