@@ -167,7 +167,10 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
 
 def arc_lengths(points: Vec) -> Vec:
     """Cumulative length at each vertex, from 0."""
-    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    d = points[1:] - points[:-1]
+    out = np.zeros(len(d) + 1)
+    np.cumsum(np.hypot(d[:, 0], d[:, 1]), out=out[1:])
+    return out
 
 
 def project(points: Vec, p: Vec) -> tuple[float, float]:
