@@ -59,3 +59,32 @@ def test_the_mover_scores_and_the_post_does_not() -> None:
                            past_points=past.points(past_window))
     assert len(scores) == 2
     assert scores[0] > 0.5 and scores[1] == 0.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_each_baseline_scores_as_motion_scores_does_alone(seed: int) -> None:
+    """MotionCue builds the clusters' points once for all its baselines; each column of
+    score_each is what motion_scores gives against that baseline's scan, to the bit."""
+    from zenav.services.perception.motion_cue import MotionCue
+
+    rng = np.random.default_rng(seed)
+    standing = [(float(rng.uniform(2, 4)), float(rng.uniform(-2, 2))) for _ in range(3)]
+    cue = MotionCue((0.2, 0.5), margin=0.1, reach=0.5, window_radius=4.0)
+    scans = []
+    for k in range(8):
+        mover = (3.0, -1.5 + 0.12 * k)
+        s = scan(0.1 * k, (0.05 * k, 0.0, 0.01 * k), [*standing, mover])
+        scans.append(s)
+        clusters = clusters_of(s)
+        each, stamps = cue.score_each(s, 0.0, clusters)
+    assert np.all(np.isfinite(stamps)) and each.any()
+    now = scans[-1]
+
+    def window(x: ScanSnapshot) -> np.ndarray:
+        beams: np.ndarray = np.flatnonzero((x.ranges < 8.0) & (x.ranges <= 4.0))
+        return beams
+
+    for j, stamp in enumerate(stamps):
+        past = next(x for x in scans if abs(x.stamp - stamp) < 1e-12)
+        alone = motion_scores(now, clusters_of(now), window(now), past, window(past), 0.1, 0.5)
+        assert np.array_equal(each[:, j], alone)
