@@ -125,8 +125,10 @@ def scores_against(clustered: ClusterPoints, current: ScanSnapshot, past: ScanSn
     if len(past_points) >= 2:
         vacated = seen_free(current, past_points, margin)
         lo, hi = clustered.lo, clustered.hi
-        near = np.all((past_points[:, None, :] >= lo[None]) & (past_points[:, None, :] <= hi[None]),
-                      axis=2)  # (past points, clusters)
+        px, py = past_points[:, 0, None], past_points[:, 1, None]
+        near = (px >= lo[None, :, 0]) & (px <= hi[None, :, 0])
+        near &= py >= lo[None, :, 1]
+        near &= py <= hi[None, :, 1]  # (past points, clusters): inside each widened box
         n_near = near.sum(axis=0)
         gone = (near & vacated[:, None]).sum(axis=0)
         share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
