@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -209,7 +210,8 @@ class Costmap:
         if cleared.any() or newly.any() or self.confirm > 0:
             self.version += 1
 
-    def _axis_cells(self, out: Vec, x: float, s: Vec, cos: Vec, axis: int) -> None:
+    def _axis_cells(self, out: Vec, x: float, s: npt.NDArray[np.floating[Any]], cos: Vec,
+                    axis: int) -> None:
         """The cell index along ``axis``, as a whole float, of every sample
         ``x + s * cos`` of every beam (the arithmetic of :meth:`cell_of`, in place)."""
         np.multiply.outer(cos, s, out=out)

@@ -197,7 +197,7 @@ def assess_all(
         clearance = np.array([robot_radius + margins[i] for i in standing], dtype=np.float64)
         every = distance - clearance[None, :]
         # Only a box with a negative gap somewhere is on the path (b): one test for all.
-        touching = (every < 0).any(axis=0)
+        touching = np.asarray((every < 0).any(axis=0))
         for column, i in enumerate(standing):
             gaps[i] = every[:, column] if touching[column] else None
     found = []
