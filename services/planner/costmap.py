@@ -210,11 +210,12 @@ class Costmap:
         if cleared.any() or newly.any() or self.confirm > 0:
             self.version += 1
 
-    def _axis_cells(self, out: Vec, x: float, s: npt.NDArray[np.floating[Any]], cos: Vec,
+    def _axis_cells(self, out: Vec, x: float, s: npt.NDArray[np.floating[Any]], unit: Vec,
                     axis: int) -> None:
         """The cell index along ``axis``, as a whole float, of every sample
-        ``x + s * cos`` of every beam (the arithmetic of :meth:`cell_of`, in place)."""
-        np.multiply.outer(cos, s, out=out)
+        ``x + s * unit`` of every beam (``unit``: the beams' direction components; the
+        arithmetic of :meth:`cell_of`, in place)."""
+        np.multiply.outer(unit, s, out=out)
         out += x
         out -= self.origin[axis]
         out /= self.resolution

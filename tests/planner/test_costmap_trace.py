@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from zenav.services.perception.clustering import to_global
 from zenav.services.planner.costmap import Costmap, ScanData
 
 
@@ -16,15 +17,16 @@ def reference_free_cells(costmap: Costmap, scan: ScanData) -> set[tuple[int, int
     each beam up to half a cell short of its return, each point through ``cell_of``."""
     x, y, heading = scan.pose
     ranges = np.asarray(scan.ranges, dtype=np.float64)
-    angles = heading + scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+    alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+    ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)  # Eq. 1 directions
     hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
     step = costmap.resolution / 2
     reach = np.where(hit, ranges - step, ranges)
     count = math.ceil(float(reach.max(initial=0.0)) / step) + 1
     s = np.arange(count) * step
     along = s[None, :] <= reach[:, None]
-    px = x + s[None, :] * np.cos(angles)[:, None]
-    py = y + s[None, :] * np.sin(angles)[:, None]
+    px = x + s[None, :] * ux[:, None]
+    py = y + s[None, :] * uy[:, None]
     cells = costmap.cell_of(np.column_stack([px[along], py[along]]))
     cells = cells[costmap.inside(cells)]
     return {(int(i), int(j)) for i, j in cells}
