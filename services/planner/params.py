@@ -83,8 +83,13 @@ class Params(MissionParams, StopZoneParams):
     )
 
     safety_horizon: float = Field(
-        6.0, gt=0, description="how far ahead the speed and safety stage rolls the robot "
-        "out against the movers, s (safety.py)"
+        6.0, gt=0, description="the longest time the speed and safety stage rolls the "
+        "robot out against the movers, s (safety.py)"
+    )
+    safety_reach: float = Field(
+        3.0, gt=0, description="the roll-outs look no farther ahead than the top speed "
+        "covers this distance in, m (in a crowd at 1 m/s: 3 s; slow robots keep "
+        "safety_horizon)"
     )
     safety_step: float = Field(0.2, gt=0, description="s between roll-out points")
     safety_growth: float = Field(
