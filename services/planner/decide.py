@@ -380,7 +380,7 @@ class Planner:
             np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.radius for o in movers], dtype=np.float64))
         settings = safety.Settings(
-            horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
+            horizon=self.safety_time(), step=p.safety_step, margin=p.safety_margin,
             growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
             fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
             turn_cost=p.safety_turn_cost)
@@ -390,6 +390,10 @@ class Planner:
         return safety.choose(robot, (heading, speed), group, carrot, blocked,
                              self.safety_heading, settings)
 
+    def safety_time(self) -> float:
+        """How far ahead the safety stage looks, s."""
+        return min(self.p.safety_horizon, self.p.safety_reach / self.p.max_speed)
+
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far
         along as the top speed reaches within the horizon, past the look-ahead point."""
@@ -398,7 +402,7 @@ class Planner:
             return path_target
         length = float(arc_lengths(self.path)[-1])
         s0 = project(self.path, robot)[0]
-        s = s0 + p.lookahead + p.max_speed * p.safety_horizon
+        s = s0 + p.lookahead + p.max_speed * self.safety_time()
         return self.goal if s >= length else point_at(self.path, s)
 
     def _crossed(self, robot: Vec, target: Vec, ob: Obstacle) -> bool:
