@@ -132,6 +132,7 @@ class Planner:
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0
         self.safety_heading: float | None = None  # the safety stage's last heading
+        self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
         if self.start is not None:
             self._set_path(np.vstack([self.start, self.goal]), "start")
 
@@ -378,9 +379,10 @@ class Planner:
         group = safety.Movers(
             np.array([o.position for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
-            np.array([o.radius for o in movers], dtype=np.float64))
+            np.array([o.radius for o in movers], dtype=np.float64),
+            np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64))
         settings = safety.Settings(
-            horizon=self.safety_time(), step=p.safety_step, margin=p.safety_margin,
+            horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
             growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
             fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
             turn_cost=p.safety_turn_cost)
@@ -390,10 +392,6 @@ class Planner:
         return safety.choose(robot, (heading, speed), group, carrot, blocked,
                              self.safety_heading, settings)
 
-    def safety_time(self) -> float:
-        """How far ahead the safety stage looks, s."""
-        return min(self.p.safety_horizon, self.p.safety_reach / self.p.max_speed)
-
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far
         along as the top speed reaches within the horizon, past the look-ahead point."""
@@ -402,7 +400,7 @@ class Planner:
             return path_target
         length = float(arc_lengths(self.path)[-1])
         s0 = project(self.path, robot)[0]
-        s = s0 + p.lookahead + p.max_speed * self.safety_time()
+        s = s0 + p.lookahead + p.max_speed * p.safety_horizon
         return self.goal if s >= length else point_at(self.path, s)
 
     def _crossed(self, robot: Vec, target: Vec, ob: Obstacle) -> bool:
@@ -664,6 +662,8 @@ class Planner:
         live = {ob.id for ob in obstacles}
         self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
         self.sides = {i: side for i, side in self.sides.items() if i in live}
+        self.top_speeds = {ob.id: max(self.top_speeds.get(ob.id, 0.0), math.hypot(*ob.velocity))
+                           for ob in obstacles if ob.kind == "dynamic"}
         robot = np.array(pose[:2], dtype=np.float64)
         if self.start is None:
             self.start = robot.copy()

@@ -86,15 +86,10 @@ class Params(MissionParams, StopZoneParams):
         6.0, gt=0, description="the longest time the speed and safety stage rolls the "
         "robot out against the movers, s (safety.py)"
     )
-    safety_reach: float = Field(
-        3.0, gt=0, description="the roll-outs look no farther ahead than the top speed "
-        "covers this distance in, m (in a crowd at 1 m/s: 3 s; slow robots keep "
-        "safety_horizon)"
-    )
     safety_step: float = Field(0.2, gt=0, description="s between roll-out points")
     safety_growth: float = Field(
-        0.2, ge=0, description="clearance added per s ahead to a mover's predicted "
-        "position (tracked velocities are estimates), m/s"
+        0.2, ge=0, description="clearance added to a mover's predicted position per m it "
+        "covers (tracked velocities are estimates; walkers turn)"
     )
     safety_comfort: float = Field(
         0.6, ge=0, description="a pass within this much beyond the clearance still costs, m"

@@ -13,8 +13,9 @@ command as the robot would actually drive it:
    down within the motor bridge's ``accel`` and ``decel``. Every ``step`` s up to
    ``horizon`` s.
 2. **Predict** each mover (a track typed dynamic) at constant velocity, its clearance
-   growing by ``growth`` m per second ahead, since tracked velocities are estimates and
-   walkers turn.
+   growing by ``growth`` times the distance it could cover at the top speed it has
+   been seen at, since tracked velocities are estimates and walkers turn and speed up
+   (0.2: a heading off by about 11 degrees).
 3. **Score** each roll-out: the cost of contact with a mover, discounted by how far ahead
    it is (``1 / (1 + t / tau)``), plus the way still to go from where it ends to a point
    on the global path the top speed could reach in the horizon, plus a small cost of
@@ -42,11 +43,13 @@ Vec = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class Movers:
-    """The movers in view: centres (m, 2), velocities (m, 2) and radii (m,)."""
+    """The movers in view: centres (m, 2), velocities (m, 2), radii (m,) and the top speed
+    each has been seen at (m,): a walker slowed by others can speed up again."""
 
     positions: Vec
     velocities: Vec
     radii: Vec
+    top_speeds: Vec
 
     def __len__(self) -> int:
         return int(self.radii.shape[0])
@@ -73,7 +76,7 @@ class Settings:
     horizon: float  # s
     step: float  # s between roll-out points
     margin: float  # m kept on top of both radii
-    growth: float  # m of extra clearance per s ahead
+    growth: float  # m of extra clearance per m the mover covers
     comfort: float  # m beyond the clearance over which a pass still costs
     tau: float  # s: a contact t s ahead costs 1 / (1 + t / tau) of one now
     fan_step: float  # rad between candidate headings
@@ -123,7 +126,8 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
     px = movers.positions[:, 0, None] + movers.velocities[:, 0, None] * times  # (m, k)
     py = movers.positions[:, 1, None] + movers.velocities[:, 1, None] * times
     gap = np.hypot(xs[:, None, :] - px[None], ys[:, None, :] - py[None])  # (n, m, k)
-    clearance = (robot_radius + movers.radii[:, None] + s.margin / 2) + s.growth * times
+    clearance = (robot_radius + movers.radii[:, None] + s.margin / 2
+                 + s.growth * movers.top_speeds[:, None] * times)
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
     touch = gap < 0.0
