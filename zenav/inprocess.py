@@ -26,6 +26,7 @@ from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
+from zenav.services.planner import safety
 from zenav.services.planner.decide import Decision, Detour, Planner
 from zenav.services.planner.node import obstacles_of, scan_data
 from zenav.services.planner.params import Params as PlannerParams
@@ -76,9 +77,9 @@ class TimedPlanner(Planner):
             return super()._assess_all(*args, **kwargs)
 
     @override
-    def safe_speed(self, *args: Any, **kwargs: Any) -> tuple[float, Obstacle | None]:
+    def speed_and_safety(self, *args: Any, **kwargs: Any) -> safety.Choice:
         with self.clock.stage("prediction"):
-            return super().safe_speed(*args, **kwargs)
+            return super().speed_and_safety(*args, **kwargs)
 
     @override
     def plan_detour(self, *args: Any, **kwargs: Any) -> Detour | None:

@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
+from zenav.services.planner import safety
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import command_toward
@@ -130,6 +131,8 @@ class Planner:
             max_rounds=params.recovery_rounds))
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0
+        self.safety_heading: float | None = None  # the safety stage's last heading
+        self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
         if self.start is not None:
             self._set_path(np.vstack([self.start, self.goal]), "start")
 
@@ -361,79 +364,44 @@ class Planner:
         v = min(max(v, 0.0), p.cruise_speed)
         return ("slow", v) if v > 1e-3 else ("stop", 0.0)
 
-    def safe_speed(
-        self, robot: Vec, direction: Vec, preferred: float, movers: list[Obstacle]
-    ) -> tuple[float, Obstacle | None]:
-        """The speed to go at along ``direction``: ``preferred`` if no mover would touch
-        the robot within ``safety_horizon`` s, else the nearest of stop, half cruise,
-        cruise and top speed that is free of contact, else the one that puts contact
-        off longest. Beyond the paper: it keeps the robot from stopping in a mover's way
-        or going on into one, whatever the scenario letter said."""
+    def speed_and_safety(
+        self, pose: tuple[float, float, float], target: Vec, speed: float,
+        movers: list[Obstacle], path_target: Vec,
+    ) -> safety.Choice:
+        """Check driving toward ``target`` at ``speed`` against every mover as the robot
+        would drive it (``safety.py``); the local layer's command if it is safe, else the
+        nearest safe heading and speed."""
         p = self.p
-        options = sorted({0.0, p.cruise_speed / 2, p.cruise_speed, p.max_speed, preferred},
-                         key=lambda v: (abs(v - preferred), -v))
-        best_v, best_t, best_who = preferred, -1.0, None
-        for v in options:
-            t, who = self._first_contact(robot, direction * v, movers)
-            if math.isinf(t):
-                return v, (best_who if v != preferred else None)
-            if v == preferred:
-                best_who = who
-            if t > best_t:
-                best_v, best_t = v, t
-        return best_v, best_who or who
+        robot = safety.Robot(
+            x=pose[0], y=pose[1], heading=pose[2], speed=self.last_v,
+            radius=p.robot_radius, max_speed=p.max_speed, max_omega=p.max_omega,
+            heading_gain=p.heading_gain, accel=p.accel, decel=p.decel)
+        group = safety.Movers(
+            np.array([o.position for o in movers], dtype=np.float64).reshape(-1, 2),
+            np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
+            np.array([o.radius for o in movers], dtype=np.float64),
+            np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64))
+        settings = safety.Settings(
+            horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
+            growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
+            fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
+            turn_cost=p.safety_turn_cost)
+        heading = math.atan2(target[1] - pose[1], target[0] - pose[0])
+        carrot = self._carrot(np.array(pose[:2], dtype=np.float64), path_target)
+        blocked = self.costmap.blocked_at if self.costmap is not None else None
+        return safety.choose(robot, (heading, speed), group, carrot, blocked,
+                             self.safety_heading, settings)
 
-    def escape(
-        self, robot: Vec, direction: Vec, movers: list[Obstacle], statics: list[Obstacle]
-    ) -> tuple[Vec, float] | None:
-        """When no speed along ``direction`` avoids a mover (one coming head-on while the
-        robot waits for a crosser, say): the straight way off, nearest in angle to
-        ``direction``, on which neither a mover comes within the clearance in the safety
-        horizon nor a standing obstacle lies. (direction, speed), or None if there is none.
-        """
+    def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
+        """The point on the global path the safety stage measures progress to: as far
+        along as the top speed reaches within the horizon, past the look-ahead point."""
         p = self.p
-        lows, highs = self._boxes(statics)
-        need = p.robot_radius + p.safety_margin
-        step = math.radians(p.fan_step_deg) * 3
-        turns = sorted((k * step for k in range(-11, 12) if k), key=lambda g: (abs(g), g))
-        for g in turns:
-            c, s = math.cos(g), math.sin(g)
-            d = np.array([direction[0] * c - direction[1] * s, direction[0] * s + direction[1] * c])
-            for v in (p.cruise_speed, p.max_speed):
-                if not math.isinf(self._first_contact(robot, d * v, movers)[0]):
-                    continue
-                if len(lows):
-                    way = path_points(robot, d, max(v * p.safety_horizon, p.cell), p.cell / 4)
-                    gaps = gap_to_boxes(way, lows, highs)
-                    if (gaps < min(need, float(gaps[0]) - 1e-6)).any():
-                        continue
-                return d, v
-        return None
-
-    def _first_contact(
-        self, robot: Vec, velocity: Vec, movers: list[Obstacle]
-    ) -> tuple[float, Obstacle | None]:
-        """Earliest time within the safety horizon at which a mover would come within
-        the clearance of the robot going at ``velocity``; (inf, None) if none does."""
-        p = self.p
-        first, who = math.inf, None
-        for ob in movers:
-            rel = np.asarray(ob.position) - robot
-            rel_v = np.asarray(ob.velocity) - velocity
-            clearance = p.robot_radius + ob.radius + p.safety_margin / 2
-            a = float(rel_v @ rel_v)
-            b = 2.0 * float(rel @ rel_v)
-            c = float(rel @ rel) - clearance * clearance
-            if c <= 0.0:
-                t = 0.0 if b < 0 else math.inf  # already close: only closing in counts
-            elif a < 1e-12 or b * b - 4 * a * c < 0:
-                t = math.inf
-            else:
-                t = (-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)
-                t = t if 0.0 <= t <= p.safety_horizon else math.inf
-            if t < first:
-                first, who = t, ob
-        return first, who
+        if self.path is None:
+            return path_target
+        length = float(arc_lengths(self.path)[-1])
+        s0 = project(self.path, robot)[0]
+        s = s0 + p.lookahead + p.max_speed * p.safety_horizon
+        return self.goal if s >= length else point_at(self.path, s)
 
     def _crossed(self, robot: Vec, target: Vec, ob: Obstacle) -> bool:
         """Whether a crosser has got across the line the robot is driving along (it is
@@ -564,6 +532,8 @@ class Planner:
         for ob_id, held in self.commitments.items():
             crosser = by_id.get(ob_id)
             if (held.letter != "e" or held.last is None or crosser is None
+                    or crosser.kind != "dynamic"
+                    or math.hypot(*crosser.velocity) < p.moving_speed  # it stopped
                     or any(a.obstacle.id == ob_id for a in threats)
                     or self._crossed(robot, target, crosser)):
                 continue
@@ -623,34 +593,32 @@ class Planner:
 
         movers = [o for o in in_window
                   if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
-        offset = target - robot
-        if p.speed_check and movers and float(np.hypot(*offset)) > 1e-9:
-            direction = offset / float(np.hypot(*offset))
-            safe, culprit = self.safe_speed(robot, direction, speed, movers)
-            doomed = not math.isinf(self._first_contact(robot, direction * safe, movers)[0])
-            way_off = self.escape(robot, direction, movers, self._statics(in_window)) \
-                if doomed else None
-            if way_off is not None and culprit is not None:
-                # Step aside: a straight detour, like a Morphin candidate, clear of all.
-                d, v = way_off
-                target = robot + d * max(v * p.safety_horizon, p.cell)
-                self.detour = Detour(target, culprit.id, "f" if self._toward(d, culprit)
-                                     else "e", 0)
-                speed, action = v, "morphin"
-                why = next((a for a in notes if a.obstacle.id == culprit.id), None)
+        # Every track typed dynamic, standing ones too: their returns are not in the map.
+        walkers = [o for o in in_window if o.kind == "dynamic"]
+        self.safety_heading = None if not movers else self.safety_heading
+        if p.speed_check and movers and float(np.hypot(*(target - robot))) > 1e-9:
+            choice = self.speed_and_safety(pose, target, speed, walkers, path_target)
+            if not choice.kept:
+                culprit = walkers[choice.mover] if choice.mover is not None else None
+                ahead = math.atan2(target[1] - robot[1], target[0] - robot[0])
+                turned = abs(math.remainder(choice.heading - ahead, math.tau))
+                reach = max(choice.speed * 2.0, p.lookahead)
+                target = robot + reach * np.array([math.cos(choice.heading),
+                                                   math.sin(choice.heading)])
+                if turned > math.radians(p.safety_fan_deg) / 2:
+                    action = "morphin"  # step aside
+                elif choice.speed > speed:
+                    action = "speed_up"
+                else:
+                    action = "stop" if choice.speed <= 0.0 else "slow"
+                speed = choice.speed
+                why = None if culprit is None else next(
+                    (a for a in notes if a.obstacle.id == culprit.id), None)
                 if why is not None:
                     lead = why
                     if why not in threats:
                         threats.append(why)
-            elif safe != speed and culprit is not None:
-                why = next((a for a in notes if a.obstacle.id == culprit.id), None)
-                if action != "morphin" or safe <= 0.0:
-                    action = "speed_up" if safe > speed else ("stop" if safe <= 0.0 else "slow")
-                speed = safe
-                if why is not None:
-                    lead = why
-                    if why not in threats:
-                        threats.append(why)
+            self.safety_heading = choice.heading
 
         if lead is None and self.detour is not None:
             action = "morphin"  # still on the way to a sub-target
@@ -694,6 +662,8 @@ class Planner:
         live = {ob.id for ob in obstacles}
         self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
         self.sides = {i: side for i, side in self.sides.items() if i in live}
+        self.top_speeds = {ob.id: max(self.top_speeds.get(ob.id, 0.0), math.hypot(*ob.velocity))
+                           for ob in obstacles if ob.kind == "dynamic"}
         robot = np.array(pose[:2], dtype=np.float64)
         if self.start is None:
             self.start = robot.copy()

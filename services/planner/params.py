@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from zenav.services.mission import CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
+from zenav.services.mission import ACCEL, CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
 from zenav.services.motor_bridge.stop_zone import StopZoneParams
 
 
@@ -83,9 +83,31 @@ class Params(MissionParams, StopZoneParams):
     )
 
     safety_horizon: float = Field(
-        6.0, gt=0, description="how far ahead the speed check looks for a mover touching "
-        "the robot, s"
+        6.0, gt=0, description="the longest time the speed and safety stage rolls the "
+        "robot out against the movers, s (safety.py)"
     )
+    safety_step: float = Field(0.2, gt=0, description="s between roll-out points")
+    safety_growth: float = Field(
+        0.2, ge=0, description="clearance added to a mover's predicted position per m it "
+        "covers (tracked velocities are estimates; walkers turn)"
+    )
+    safety_comfort: float = Field(
+        0.6, ge=0, description="a pass within this much beyond the clearance still costs, m"
+    )
+    safety_tau: float = Field(
+        1.5, gt=0, description="a contact t s ahead costs 1 / (1 + t / tau) of one now, s"
+    )
+    safety_fan_deg: float = Field(
+        15.0, gt=0, le=90, description="angle between the headings tried all round, deg"
+    )
+    safety_speeds: tuple[float, ...] = Field(
+        (0.0, 0.25, 0.5, 0.75, 1.0), description="fractions of max_speed tried per heading"
+    )
+    safety_turn_cost: float = Field(
+        0.3, ge=0, description="cost per rad of heading change from the last choice"
+    )
+    accel: float = Field(ACCEL, gt=0, description="forward acceleration limit of the "
+                         "commands (the motor bridge's), m/s^2")
 
     # --- Algorithm 1 (the paper profile sets these to the paper's rules) -------------
     threats_per_cycle: Literal["all", "one"] = Field(

@@ -1,0 +1,176 @@
+"""The speed and safety stage: check the local layer's command against every mover and
+pick the nearest safe one when it is not safe (pure, no I/O).
+
+Beyond the paper. The paper's responses answer one predicted meeting at a time along a
+straight line; in a crowd a stop that lets one walker pass leaves the robot in another's
+way, and a walker that does not see the robot keeps coming. This stage looks at the
+command as the robot would actually drive it:
+
+1. **Roll out** each candidate: a heading (the local layer's, or one of a fan round
+   it) and a speed (0 up to the top speed). The robot is the unicycle that
+   ``follow.command_toward`` drives: it turns at up to ``max_omega`` toward the heading,
+   its speed falls with the cosine of the heading error, and it speeds up and slows
+   down within the motor bridge's ``accel`` and ``decel``. Every ``step`` s up to
+   ``horizon`` s.
+2. **Predict** each mover (a track typed dynamic) at constant velocity, its clearance
+   growing by ``growth`` times the distance it could cover at the top speed it has
+   been seen at, since tracked velocities are estimates and walkers turn and speed up
+   (0.2: a heading off by about 11 degrees).
+3. **Score** each roll-out: the cost of contact with a mover, discounted by how far ahead
+   it is (``1 / (1 + t / tau)``), plus the way still to go from where it ends to a point
+   on the global path the top speed could reach in the horizon, plus a small cost of
+   changing heading from the last choice (no dithering between equal options). Contact
+   means coming within the robot radius + the mover's radius + half the safety margin
+   + the growth; a pass within a further ``comfort`` m costs in proportion. Points the
+   map holds (standing obstacles, inflated) are contact at once.
+
+The local layer's own command stands when its roll-out keeps clear of every mover
+within ``horizon``: the paper's responses are kept whenever they are safe. Otherwise the
+cheapest candidate is driven for this cycle, and the next cycle checks again.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+Vec = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Movers:
+    """The movers in view: centres (m, 2), velocities (m, 2), radii (m,) and the top speed
+    each has been seen at (m,): a walker slowed by others can speed up again."""
+
+    positions: Vec
+    velocities: Vec
+    radii: Vec
+    top_speeds: Vec
+
+    def __len__(self) -> int:
+        return int(self.radii.shape[0])
+
+
+@dataclass(frozen=True)
+class Robot:
+    """What the roll-outs need to know about the robot."""
+
+    x: float
+    y: float
+    heading: float
+    speed: float  # its speed now, m/s
+    radius: float
+    max_speed: float
+    max_omega: float
+    heading_gain: float
+    accel: float
+    decel: float
+
+
+@dataclass(frozen=True)
+class Settings:
+    horizon: float  # s
+    step: float  # s between roll-out points
+    margin: float  # m kept on top of both radii
+    growth: float  # m of extra clearance per m the mover covers
+    comfort: float  # m beyond the clearance over which a pass still costs
+    tau: float  # s: a contact t s ahead costs 1 / (1 + t / tau) of one now
+    fan_step: float  # rad between candidate headings
+    speeds: tuple[float, ...]  # fractions of the top speed tried
+    turn_cost: float  # cost per rad of change from the last heading chosen
+
+
+@dataclass(frozen=True)
+class Choice:
+    heading: float  # world frame, rad
+    speed: float  # m/s
+    kept: bool  # the local layer's own command was safe and is kept
+    contact: float  # s to the first contact of the chosen roll-out (inf: none)
+    mover: int | None  # index in Movers of the mover that made the change, if any
+
+
+def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, Vec]:
+    """Positions (n, k) of the robot driving toward each heading at each speed, at
+    ``times`` (k,), evenly spaced from one step on."""
+    dt = float(times[0])
+    n = headings.shape[0]
+    xs = np.empty((n, times.shape[0]))
+    ys = np.empty_like(xs)
+    x = np.full(n, robot.x)
+    y = np.full(n, robot.y)
+    theta = np.full(n, robot.heading)
+    v = np.full(n, robot.speed)
+    for k in range(times.shape[0]):
+        error = np.angle(np.exp(1j * (headings - theta)))
+        omega = np.clip(robot.heading_gain * error, -robot.max_omega, robot.max_omega)
+        wanted = speeds * np.maximum(np.cos(error), 0.0)
+        v = np.clip(wanted, v - robot.decel * dt, v + robot.accel * dt)
+        theta = theta + omega * dt
+        x = x + v * np.cos(theta) * dt
+        y = y + v * np.sin(theta) * dt
+        xs[:, k], ys[:, k] = x, y
+    return xs, ys
+
+
+def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,
+                  s: Settings) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
+    """Per roll-out: the cost of its passes by the movers, the time of its first contact
+    (inf: none) and the mover of that contact (-1: none)."""
+    n = xs.shape[0]
+    if len(movers) == 0:
+        return np.zeros(n), np.full(n, math.inf), np.full(n, -1, dtype=np.int64)
+    px = movers.positions[:, 0, None] + movers.velocities[:, 0, None] * times  # (m, k)
+    py = movers.positions[:, 1, None] + movers.velocities[:, 1, None] * times
+    gap = np.hypot(xs[:, None, :] - px[None], ys[:, None, :] - py[None])  # (n, m, k)
+    clearance = (robot_radius + movers.radii[:, None] + s.margin / 2
+                 + s.growth * movers.top_speeds[:, None] * times)
+    gap -= clearance[None]
+    weight = 1.0 / (1.0 + times / s.tau)
+    touch = gap < 0.0
+    near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
+    cost_mk = np.where(touch, 10.0, near) * weight  # (n, m, k)
+    cost = cost_mk.max(axis=2).sum(axis=1)
+    any_touch = touch.any(axis=1)  # (n, k)
+    first_k = np.where(any_touch.any(axis=1), any_touch.argmax(axis=1), -1)
+    first_t = np.where(first_k >= 0, times[np.maximum(first_k, 0)], math.inf)
+    who = np.where(first_k >= 0,
+                   touch[np.arange(n), :, np.maximum(first_k, 0)].argmax(axis=1), -1)
+    return cost, first_t, who.astype(np.int64)
+
+
+def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: Vec,
+           blocked: Callable[[Vec], npt.NDArray[np.bool_]] | None, last_heading: float | None,
+           s: Settings) -> Choice:
+    """Check the local layer's ``proposal`` (heading rad, speed m/s) and keep it if its
+    roll-out touches no mover within the horizon; else the cheapest candidate. ``carrot``:
+    the point on the global path progress is measured to; ``blocked``: which points the
+    map holds (None: no map)."""
+    heading, speed = proposal
+    fan = np.arange(-math.pi, math.pi, s.fan_step)
+    headings = np.concatenate(([heading], np.repeat(heading + fan, len(s.speeds))))
+    speeds = np.concatenate(([speed], np.tile(np.asarray(s.speeds) * robot.max_speed,
+                                              fan.shape[0])))
+    steps = max(round(s.horizon / s.step), 1)
+    times = s.step * np.arange(1, steps + 1)
+    xs, ys = rollout(robot, headings, speeds, times)
+    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
+    if blocked is not None:
+        walls = blocked(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
+        start_blocked = bool(blocked(np.array([[robot.x, robot.y]]))[0])
+        if not start_blocked:  # inside the inflation already: the map cannot judge
+            hit = walls.any(axis=1)
+            cost = cost + np.where(hit, 10.0, 0.0)
+    if math.isinf(first_t[0]) and cost[0] < 10.0:
+        return Choice(heading, speed, True, math.inf, None)
+    reach = np.hypot(xs[:, -1] - carrot[0], ys[:, -1] - carrot[1])
+    total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
+    if last_heading is not None:
+        total = total + s.turn_cost * np.abs(np.angle(np.exp(1j * (headings - last_heading))))
+    best = int(np.argmin(total))
+    culprit = int(who[0]) if who[0] >= 0 else None
+    return Choice(float(np.angle(np.exp(1j * headings[best]))), float(speeds[best]),
+                  best == 0, float(first_t[best]), culprit)
