@@ -1,0 +1,158 @@
+"""The speed and safety stage (safety.py) on hand-made geometry, and inside a planner
+cycle: roll-outs, contact times worked by hand, and the choices it makes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.services.planner import safety
+from zenav.services.planner.decide import Planner
+from zenav.services.planner.params import Params
+from zenav.services.planner.prediction import Obstacle
+
+SETTINGS = safety.Settings(horizon=6.0, step=0.2, margin=0.1, growth=0.0, comfort=0.6,
+                           tau=1.5, fan_step=math.radians(15.0),
+                           speeds=(0.0, 0.25, 0.5, 0.75, 1.0), turn_cost=0.3)
+
+
+def robot(speed: float = 0.0, heading: float = 0.0) -> safety.Robot:
+    return safety.Robot(x=0.0, y=0.0, heading=heading, speed=speed, radius=0.3,
+                        max_speed=1.0, max_omega=1.0, heading_gain=1.5, accel=0.5, decel=1.0)
+
+
+def movers(*rows: tuple[float, float, float, float]) -> safety.Movers:
+    """Movers of radius 0.3 from (x, y, vx, vy) rows, each seen at its speed now."""
+    a = np.array(rows, dtype=np.float64).reshape(-1, 4)
+    return safety.Movers(a[:, :2], a[:, 2:], np.full(len(a), 0.3), np.hypot(a[:, 2], a[:, 3]))
+
+
+def times(step: float = 0.2, horizon: float = 6.0) -> npt.NDArray[np.float64]:
+    return step * np.arange(1, round(horizon / step) + 1)
+
+
+def test_rollout_straight_speeds_up_within_accel() -> None:
+    # From standstill toward heading 0 at 1 m/s: v = 0.1, 0.2, ... (0.5 m/s^2 x 0.2 s),
+    # and each step moves v * 0.2 after the speed change.
+    xs, ys = safety.rollout(robot(), np.array([0.0]), np.array([1.0]), times())
+    v = np.minimum(0.1 * np.arange(1, 31), 1.0)
+    assert np.allclose(xs[0], np.cumsum(v * 0.2))
+    assert np.allclose(ys[0], 0.0)
+
+
+def test_rollout_turns_at_the_turn_limit_before_driving() -> None:
+    # A heading 90 degrees off: the error stays above 1/1.5 rad for the first steps, so
+    # the robot turns at 1 rad/s, and its speed waits for the cosine of the error.
+    xs, ys = safety.rollout(robot(), np.array([math.pi / 2]), np.array([1.0]), times())
+    assert abs(xs[0, 0]) < 1e-12 and abs(ys[0, 0]) < 1e-12  # cos(90 - 11.5 deg) ~ 0.2...
+    assert ys[0, -1] > 3.0 and abs(xs[0, -1]) < 1.0  # ...then on its way up +y
+
+
+def test_contact_time_of_a_head_on_walker_worked_by_hand() -> None:
+    # The robot stands at the origin; a walker at (3.1, 0) comes at 1 m/s. Contact is
+    # within 0.3 + 0.3 + 0.1 / 2 = 0.65 m, so when 3.1 - t < 0.65: t > 2.45 s, first
+    # sampled at 2.6 s.
+    t = times()
+    xs, ys = safety.rollout(robot(), np.array([0.0]), np.array([0.0]), t)
+    cost, first, who = safety.contact_costs(xs, ys, t, movers((3.1, 0.0, -1.0, 0.0)), 0.3,
+                                            SETTINGS)
+    assert math.isclose(float(first[0]), 2.6)
+    assert int(who[0]) == 0
+    assert math.isclose(float(cost[0]), 10.0 / (1.0 + 2.6 / 1.5))  # the worst, discounted
+
+
+def test_growth_brings_contact_forward() -> None:
+    # With 0.2 m of clearance per metre the walker covers: 3.1 - t < 0.65 + 0.2 t,
+    # t > 2.0417 s, first sampled at 2.2 s.
+    t = times()
+    xs, ys = safety.rollout(robot(), np.array([0.0]), np.array([0.0]), t)
+    grown = safety.Settings(**{**SETTINGS.__dict__, "growth": 0.2})
+    _, first, _ = safety.contact_costs(xs, ys, t, movers((3.1, 0.0, -1.0, 0.0)), 0.3, grown)
+    assert math.isclose(float(first[0]), 2.2)
+
+
+def test_a_pass_outside_the_comfort_band_costs_nothing() -> None:
+    # A walker crossing 2 m ahead of a standing robot never comes within 0.65 + 0.6 m.
+    t = times()
+    xs, ys = safety.rollout(robot(), np.array([0.0]), np.array([0.0]), t)
+    cost, first, who = safety.contact_costs(xs, ys, t, movers((2.0, -3.0, 0.0, 1.0)), 0.3,
+                                            SETTINGS)
+    assert float(cost[0]) == 0.0 and math.isinf(float(first[0])) and int(who[0]) == -1
+
+
+def test_a_safe_proposal_is_kept() -> None:
+    choice = safety.choose(robot(1.0), (0.0, 1.0), movers((0.0, 5.0, 1.0, 0.0)),
+                           np.array([6.0, 0.0]), None, None, SETTINGS)
+    assert choice.kept and choice.heading == 0.0 and choice.speed == 1.0
+
+
+def test_a_stopped_robot_steps_aside_from_a_walker_coming_from_behind() -> None:
+    # The local layer says wait; a walker that does not see the robot comes from behind
+    # at 1 m/s. Waiting is contact in under 3 s (the walker made the change); the choice
+    # drives off (ahead, keeping the gap: 3 - t + 0.25 t^2 >= 2 m while speeding up).
+    m = movers((-3.0, 0.0, 1.0, 0.0))
+    choice = safety.choose(robot(), (0.0, 0.0), m, np.array([6.0, 0.0]), None, None,
+                           SETTINGS)
+    assert not choice.kept and choice.mover == 0
+    assert choice.speed > 0.0 and math.isinf(choice.contact)  # the chosen roll-out is clear
+    t = times()
+    xs, ys = safety.rollout(robot(), np.array([choice.heading]), np.array([choice.speed]), t)
+    _, first, _ = safety.contact_costs(xs, ys, t, m, 0.3, SETTINGS)
+    assert math.isinf(float(first[0]))  # ...as its own roll-out shows
+
+
+def test_a_walker_crossing_just_ahead_is_not_driven_into() -> None:
+    # Driving on at 1 m/s meets a walker crossing 1.5 m ahead; the choice touches nobody.
+    m = movers((1.5, -1.5, 0.0, 1.0))
+    choice = safety.choose(robot(1.0), (0.0, 1.0), m, np.array([6.0, 0.0]), None, None,
+                           SETTINGS)
+    assert not choice.kept and choice.mover == 0
+    assert math.isinf(choice.contact)
+
+
+def test_the_map_rules_out_headings_into_a_wall() -> None:
+    # Everything at x > 0.8 is a wall; a walker comes from behind. The robot goes
+    # sideways or back, never forward into the wall.
+    def wall(points: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]:
+        return np.asarray(points[:, 0] > 0.8)
+
+    choice = safety.choose(robot(), (0.0, 0.0), movers((-3.0, 0.0, 1.0, 0.0)),
+                           np.array([6.0, 0.0]), wall, None, SETTINGS)
+    assert math.cos(choice.heading) < 0.5
+
+
+def test_the_last_heading_wins_a_tie() -> None:
+    # A walker comes head-on along the robot's line: stepping left or right is the same
+    # but for the turn cost from the last heading chosen.
+    m = movers((2.5, 0.0, -1.0, 0.0))
+    left = safety.choose(robot(), (0.0, 0.0), m, np.array([6.0, 0.0]), None, math.pi / 2,
+                         SETTINGS)
+    right = safety.choose(robot(), (0.0, 0.0), m, np.array([6.0, 0.0]), None, -math.pi / 2,
+                          SETTINGS)
+    assert math.sin(left.heading) >= 0.0 >= math.sin(right.heading)
+
+
+def crowd_planner(speed_check: bool) -> Planner:
+    return Planner(Params.model_validate({
+        "goal": (8.0, 0.0), "start": (0.0, 0.0), "cruise_speed": 1.0, "max_speed": 1.0,
+        "robot_radius": 0.3, "use_map": False, "speed_check": speed_check}))
+
+
+def test_planner_cycle_does_not_wait_for_a_crosser_with_a_walker_behind() -> None:
+    # A crosser ahead (it meets the robot's line at x = 1.5 in 1.5 s): the paper's (e)
+    # says stop. A walker that does not see the robot comes from behind on its line.
+    # Without the stage the robot stops and is walked into; with it, it steps aside.
+    crosser = Obstacle(3, "dynamic", (1.5, -1.2), (0.0, 0.8), 0.3, (3, 3, -2, -2))
+    walker = Obstacle(7, "dynamic", (-2.0, 0.0), (1.0, 0.0), 0.3, (-4, -4, 0, 0))
+    decisions = []
+    for check in (False, True):
+        p = crowd_planner(check)
+        for t in (0.0, 0.1):
+            d = p.step((0.0, 0.0, 0.0), [crosser, walker], t)
+        decisions.append(d)
+    waits, steps_aside = decisions
+    assert (waits.action, waits.speed) == ("stop", 0.0) and waits.scenario == "e"
+    assert steps_aside.action == "morphin" and steps_aside.speed > 0.0
+    assert abs(steps_aside.target[1]) > 0.5  # off the line the walker comes along
