@@ -15,7 +15,7 @@ pytestmark = pytest.mark.integration
 def test_bench_crowd_on_two_cases_with_one_planner(tmp_path):
     done = subprocess.run(
         [sys.executable, "-m", "zenav", "bench", "crowd", "--cases", "2", "--planners", "orca",
-         "--settings", "circle-invisible-360", "--jobs", "2", "--no-progress",
+         "--settings", "circle-invisible-360", "--jobs", "2", "--no-progress", "--engine", "stack",
          "--out", str(tmp_path)], capture_output=True, text=True, timeout=600, check=False)
     assert done.returncode == 0, done.stderr
     report = (tmp_path / "crowd.md").read_text()

@@ -226,7 +226,7 @@ def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: 
 
 
 def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int = 0,
-              settings: Sequence[str] = tuple(SETTINGS), jobs: int = 2, engine: str = "stack",
+              settings: Sequence[str] = tuple(SETTINGS), jobs: int = 2, engine: str = "inprocess",
               progress: bool = True,
               echo: Callable[[str], None] = print) -> str:
     """Write the cases, run them, print and write ``crowd.md``, ``crowd.png``, ``crowd.json``."""
@@ -324,9 +324,11 @@ def add_command(kinds: Any) -> None:
     crowd.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                        help="runs at a time (default: the number of cores; each run is six "
                        "processes)")
-    crowd.add_argument("--engine", default="stack",
-                       help=f"how each run is made: {', '.join(ENGINES)} (default stack: "
-                       "zenav run's path, the whole service stack)")
+    crowd.add_argument("--engine", default="inprocess",
+                       help=f"how each run is made: {', '.join(ENGINES)} (default "
+                       "inprocess: the services in one process per run, three cases made "
+                       "again through the stack and compared; stack: every run through "
+                       "zenav run's six processes)")
     crowd.add_argument("--out", type=Path, default=Path("out/bench-crowd"),
                        help="directory for the cases, runs, crowd.md, crowd.png, crowd.json")
     crowd.add_argument("--no-progress", action="store_true", help="no progress bar")
