@@ -3,8 +3,8 @@
 Settings are {circle, square} crossing x {invisible, visible} humans x {180°, 360°}
 laser (:mod:`zenav.sim.crowdnav` writes the cases as scenario files: case k is CrowdNav's
 test case k). Each (setting, case, planner) is one run through an *engine*: ``stack``
-(``zenav run``'s path through :mod:`zenav.batch`, six processes over Zenoh; the default)
-or any engine registered in :data:`ENGINES` (the in-process engine plugs in here),
+(``zenav run``'s path through :mod:`zenav.batch`, six processes over Zenoh) or any engine
+registered in :data:`ENGINES` (``inprocess``, the default, plugs in here),
 ``--jobs`` at a time; a run whose ``run.json`` is already in ``--out`` is not repeated.
 
 Columns are CrowdNav's: success, collision and timeout rates, the mean time to goal of
