@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
+from zenav.services.geometry import wrap_angle
 from zenav.services.planner import safety
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
@@ -601,7 +602,7 @@ class Planner:
             if not choice.kept:
                 culprit = walkers[choice.mover] if choice.mover is not None else None
                 ahead = math.atan2(target[1] - robot[1], target[0] - robot[0])
-                turned = abs(math.remainder(choice.heading - ahead, math.tau))
+                turned = abs(wrap_angle(choice.heading - ahead))
                 reach = max(choice.speed * 2.0, p.lookahead)
                 target = robot + reach * np.array([math.cos(choice.heading),
                                                    math.sin(choice.heading)])
@@ -832,8 +833,7 @@ class Planner:
             done()
             return Decision(0.0, 0.0, goal_xy, "a", "replan", None, None, 0.0)
         if act.step == "spin":
-            turn = math.atan2(math.sin(pose[2] - act.last_heading),
-                              math.cos(pose[2] - act.last_heading))
+            turn = wrap_angle(pose[2] - act.last_heading)
             act.turned += abs(turn)
             act.last_heading = pose[2]
             bound = r.s.spin_angle / (0.5 * p.max_omega) + 5.0
@@ -876,7 +876,7 @@ class Planner:
                         max(d.v, self.last_v), p.robot_radius):
             return d
         error = math.atan2(d.target[1] - pose[1], d.target[0] - pose[0]) - pose[2]
-        error = math.atan2(math.sin(error), math.cos(error))
+        error = wrap_angle(error)
         turns = sorted((math.radians(g) for g in range(-90, 91, 10)),
                        key=lambda g: (abs(g - error), g))
         free = next((g for g in turns if abs(g) > 1e-9 and not p.blocks(

@@ -38,6 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.geometry import wrap_angle, wrap_angles
+
 Vec = npt.NDArray[np.float64]
 
 
@@ -105,7 +107,7 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
     theta = np.full(n, robot.heading)
     v = np.full(n, robot.speed)
     for k in range(times.shape[0]):
-        error = np.angle(np.exp(1j * (headings - theta)))
+        error = wrap_angles(headings - theta)
         omega = np.clip(robot.heading_gain * error, -robot.max_omega, robot.max_omega)
         wanted = speeds * np.maximum(np.cos(error), 0.0)
         v = np.clip(wanted, v - robot.decel * dt, v + robot.accel * dt)
@@ -169,8 +171,8 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     reach = np.hypot(xs[:, -1] - carrot[0], ys[:, -1] - carrot[1])
     total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
     if last_heading is not None:
-        total = total + s.turn_cost * np.abs(np.angle(np.exp(1j * (headings - last_heading))))
+        total = total + s.turn_cost * np.abs(wrap_angles(headings - last_heading))
     best = int(np.argmin(total))
     culprit = int(who[0]) if who[0] >= 0 else None
-    return Choice(float(np.angle(np.exp(1j * headings[best]))), float(speeds[best]),
+    return Choice(wrap_angle(float(headings[best])), float(speeds[best]),
                   best == 0, float(first_t[best]), culprit)

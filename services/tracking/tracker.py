@@ -45,6 +45,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
+from zenav.services.geometry import wrap_angle
 from zenav.services.perception.clustering import (
     EDGE_FREE,
     EDGE_OCCLUDED,
@@ -328,8 +329,7 @@ class Tracker:
         distance = math.hypot(dx, dy)
         if distance - t.radius > self.params.window_radius:
             return False
-        bearing = math.atan2(dy, dx) - pose[2]
-        bearing = math.atan2(math.sin(bearing), math.cos(bearing))
+        bearing = wrap_angle(math.atan2(dy, dx) - pose[2])
         return abs(bearing) <= math.radians(self.params.fov_deg) / 2
 
     # --- association -------------------------------------------------------------------
