@@ -10,26 +10,16 @@ import io
 import numpy as np
 from rich.console import Console
 
-from tests.planner.scans import scan_of
 from tests.service.harness import running
+from tests.service.test_planner_node import POSE, scan  # the wall with a 1 m gap
 from zenav.monitor.model import MonitorModel
 from zenav.monitor.screen import render
 from zenav.monitor.view import GOAL, OCCUPIED, PATH
 from zenav.schemas import keys
-from zenav.schemas.messages import LaserScan, Odometry, Pose2D, TrackList
+from zenav.schemas.messages import Odometry, Pose2D, TrackList
 from zenav.services.planner.params import Params
 
-POSE = (2.0, 3.0, 0.0)
-WALL = [(6.0, -1.0, 6.2, 4.5), (6.0, 5.5, 6.2, 9.0)]  # a 1 m gap from y = 4.5 to 5.5
 T0 = 1_000_000.0
-
-
-def scan(t: float) -> LaserScan:
-    data = scan_of(POSE, boxes=WALL)
-    return LaserScan(stamp=t, seq=0, frame="laser", angle_min=data.angle_min,
-                     angle_max=-data.angle_min, angle_increment=data.angle_increment,
-                     range_min=0.0, range_max=data.range_max,
-                     ranges=data.ranges.astype(np.float32))
 
 
 async def test_the_monitor_shows_the_planners_path_and_map():
