@@ -132,12 +132,12 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
                  + s.growth * movers.top_speeds[:, None] * times)
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
-    touch = gap < 0.0
+    touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
     near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
     cost_mk = np.where(touch, 10.0, near) * weight  # (n, m, k)
     cost = cost_mk.max(axis=2).sum(axis=1)
-    any_touch = touch.any(axis=1)  # (n, k)
-    first_k = np.where(any_touch.any(axis=1), any_touch.argmax(axis=1), -1)
+    any_touch: npt.NDArray[np.bool_] = np.any(touch, axis=1)  # (n, k)
+    first_k = np.where(np.any(any_touch, axis=1), np.argmax(any_touch, axis=1), -1)
     first_t = np.where(first_k >= 0, times[np.maximum(first_k, 0)], math.inf)
     who = np.where(first_k >= 0,
                    touch[np.arange(n), :, np.maximum(first_k, 0)].argmax(axis=1), -1)
@@ -157,7 +157,7 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     speeds = np.concatenate(([speed], np.tile(np.asarray(s.speeds) * robot.max_speed,
                                               fan.shape[0])))
     steps = max(round(s.horizon / s.step), 1)
-    times = s.step * np.arange(1, steps + 1)
+    times = s.step * np.arange(1, steps + 1, dtype=np.float64)
     xs, ys = rollout(robot, headings, speeds, times)
     cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
     if blocked is not None:
