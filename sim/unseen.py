@@ -18,25 +18,25 @@ Each scene is drawn in a frame where the robot drives toward +x, then turned by 
 multiple of 90 degrees (so boxes stay axis-aligned) and maybe mirrored, so goals lie in
 every direction. A draw is kept only when :func:`solvable` finds a way for the robot
 disc through the static geometry (every obstacle that ever stands still, whenever it
-appears); otherwise the next draw of the same seed is tried. Pure: the same class and
-seed give the same scene.
+appears) by a flood fill on a fine grid; otherwise the next draw of the same seed is
+tried. Pure: the same class and seed give the same scene.
 """
 
 from __future__ import annotations
 
 import math
-from collections import deque
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from zenav.sim.scenario import Scenario, parse_scenario
 
 CLASSES = ("appear", "wall-gap", "cup", "corridor", "posts", "mover-stops", "facing-away")
 FAMILY_PREFIX = "unseen-"  # a scene's name: unseen-<class>-<seed>
 RADIUS = 0.2  # the robot disc, m
-BFS_CELL = 0.025  # m: fine enough to see a gap of 2.5 robot radii
+WAY_CELL = 0.025  # m: fine enough to see a gap of 2.5 robot radii
 DRAWS = 50  # tries per seed before giving up
 
 Obstacle = dict[str, Any]
@@ -192,6 +192,7 @@ def _mover_stops(rng: np.random.Generator, speed: float) -> Draw:
         sign = float(rng.choice([-1.0, 1.0]))
         direction = (-unit[1] * sign, unit[0] * sign)
     appear = round(stop - run / v, 1)
+    run = v * (stop - appear)  # so that it is on the spot when it stops
     mx, my = px - direction[0] * run, py - direction[1] * run
     radius = float(rng.uniform(0.2, 0.3))
     return width, height, start, goal, 0.0, [
@@ -281,7 +282,7 @@ def _placed(draw: Draw, quarter: int, mirror: bool) -> tuple[list[float], dict[s
 
 # --- is there a way? -------------------------------------------------------------------
 
-def free_grid(scenario: Scenario, cell: float = BFS_CELL) -> NDArray[np.bool_]:
+def free_grid(scenario: Scenario, cell: float = WAY_CELL) -> NDArray[np.bool_]:
     """Cells (rows: y, columns: x) where the robot disc's centre clears every obstacle
     that ever stands still, and stays inside the world. Movers are left out: they pass."""
     width, height = scenario.world.size
@@ -305,9 +306,9 @@ def free_grid(scenario: Scenario, cell: float = BFS_CELL) -> NDArray[np.bool_]:
     return free
 
 
-def solvable(scenario: Scenario, cell: float = BFS_CELL) -> bool:
-    """A breadth-first search over :func:`free_grid` (4-neighbours) finds a way from the
-    start cell to a cell within the goal tolerance."""
+def solvable(scenario: Scenario, cell: float = WAY_CELL) -> bool:
+    """The start cell and a cell within the goal tolerance lie in one 4-connected region
+    of :func:`free_grid` (a flood fill, as a breadth-first search would find)."""
     free = free_grid(scenario, cell)
     rows, cols = free.shape
     sx, sy = scenario.robot.start
@@ -315,21 +316,11 @@ def solvable(scenario: Scenario, cell: float = BFS_CELL) -> bool:
     start = (min(int(sy / cell), rows - 1), min(int(sx / cell), cols - 1))
     if not free[start]:
         return False
+    regions, _ = ndimage.label(free)  # 4-connected by default
     ys = (np.arange(rows) + 0.5) * cell
     xs = (np.arange(cols) + 0.5) * cell
     near = np.hypot(xs[None, :] - gx, ys[:, None] - gy) <= scenario.robot.goal_tolerance
-    seen = np.zeros_like(free)
-    seen[start] = True
-    queue = deque([start])
-    while queue:
-        i, j = queue.popleft()
-        if near[i, j]:
-            return True
-        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
-            if 0 <= a < rows and 0 <= b < cols and free[a, b] and not seen[a, b]:
-                seen[a, b] = True
-                queue.append((a, b))
-    return False
+    return bool((regions[near] == regions[start]).any())
 
 
 # --- the scenes ------------------------------------------------------------------------
