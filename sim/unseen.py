@@ -161,7 +161,7 @@ def _posts(rng: np.random.Generator, speed: float) -> Draw:
     half = float(rng.uniform(1.5, 3.0))  # the field's half-height about the line
     mid = (start[1] + goal[1]) / 2 + float(rng.uniform(-0.5, 0.5))
     phase = float(rng.uniform(0.0, dy))
-    obstacles = []
+    obstacles: list[Obstacle] = []
     for k in range(rows):
         x = x0 + k * dx
         y = mid - half + phase + (dy / 2 if k % 2 else 0.0)
@@ -205,7 +205,7 @@ def _mover_stops(rng: np.random.Generator, speed: float) -> Draw:
 def _facing_away(rng: np.random.Generator, speed: float) -> Draw:
     width, height = float(rng.uniform(8.0, 13.0)), float(rng.uniform(5.0, 9.0))
     start, goal = _line(rng, width, height, slant=0.6)
-    obstacles = []
+    obstacles: list[Obstacle] = []
     length = math.dist(start, goal)
     for _ in range(int(rng.integers(1, 3))):
         f = float(rng.uniform(0.3, 0.7))
@@ -303,7 +303,7 @@ def free_grid(scenario: Scenario, cell: float = WAY_CELL) -> NDArray[np.bool_]:
             dx = np.maximum(np.abs(gx - cx) - o.size[0] / 2, 0.0)
             dy = np.maximum(np.abs(gy - cy) - o.size[1] / 2, 0.0)
             free &= np.hypot(dx, dy) > r
-    return free
+    return np.asarray(free, dtype=bool)
 
 
 def solvable(scenario: Scenario, cell: float = WAY_CELL) -> bool:
