@@ -27,9 +27,19 @@ from zenav.batch import DEFAULT_VERIFY, Job, Records, default_jobs, run_batch
 from zenav.bench.common import machine, words
 from zenav.engine import ENGINES
 from zenav.sim.generate import FAMILIES, random_scenario
-from zenav.sim.scenario import dump_scenario
+from zenav.sim.scenario import Scenario, dump_scenario
+from zenav.sim.unseen import CLASSES, FAMILY_PREFIX, unseen_scenario
 
 TARGET_MIXED_SUCCESS = 0.98  # the paper planner on the mixed set, with 0 collisions
+UNSEEN = tuple(FAMILY_PREFIX + c for c in CLASSES)  # scenes of the issue's classes
+KNOWN = FAMILIES + UNSEEN
+
+
+def world(family: str, seed: int) -> Scenario:
+    """The scene of ``family`` for ``seed``: a random world or an unseen class scene."""
+    if family.startswith(FAMILY_PREFIX):
+        return unseen_scenario(family.removeprefix(FAMILY_PREFIX), seed)
+    return random_scenario(family, seed)
 
 
 def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path) -> list[Path]:
@@ -38,7 +48,7 @@ def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path
     for family in families:
         for s in range(seed, seed + count):
             path = directory / f"{family}-{s}.yaml"
-            paths.append(dump_scenario(random_scenario(family, s), path))
+            paths.append(dump_scenario(world(family, s), path))
     return paths
 
 
@@ -135,7 +145,7 @@ def tables(summaries: list[PlannerSummary], families: dict[str, dict[str, float]
     planners = [s.planner for s in summaries]
     lines += ["", "| family | " + " | ".join(f"{p}: success (collisions)" for p in planners)
               + " |", "|---|" + "---|" * len(planners)]
-    for family in FAMILIES:
+    for family in KNOWN:
         if family not in families:
             continue
         cell = families[family]
@@ -150,7 +160,9 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
     paper = next((s for s in summaries if s.planner == "paper"), None)
     if paper is None:
         return ""
-    mixed = families.get("mixed", {})
+    if "mixed" not in families:
+        return ""  # the goal is on the mixed set
+    mixed = families["mixed"]
     n = mixed.get("paper/n", 0)
     ok = mixed.get("paper/ok", 0)
     hits = int(mixed.get("paper/hit", 0))
@@ -176,7 +188,7 @@ def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
                 "collision": [s.rate(s.collisions) for s in summaries]}
     success = {f: [100 * families[f].get(p + "/ok", 0) / families[f][p + "/n"]
                    if families[f].get(p + "/n", 0) else 0.0 for p in planners]
-               for f in FAMILIES if f in families}
+               for f in KNOWN if f in families}
     draw_bench_chart(planners, outcomes, success, path)
 
 
@@ -210,9 +222,11 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     if unknown:
         raise ValueError(f"unknown planner {', '.join(unknown)}; choose from "
                          f"{', '.join(PLANNERS)}")
-    bad = [f for f in families if f not in FAMILIES]
+    families = [f for name in families for f in (UNSEEN if name == "unseen" else (name,))]
+    bad = [f for f in families if f not in KNOWN]
     if bad:
-        raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(FAMILIES)}")
+        raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(KNOWN)} "
+                         "or unseen (all the unseen-* classes)")
     out.mkdir(parents=True, exist_ok=True)
     paths = write_worlds(families, worlds, seed, out / "worlds")
     job_list = [Job(f"{p}/{w.stem}", w, out / "runs" / p / w.stem, planner=p)
@@ -273,7 +287,8 @@ def add_command(kinds: Any) -> None:
     nav.add_argument("--worlds", type=int, default=5, help="worlds per family (default 5)")
     nav.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     nav.add_argument("--families", default=",".join(FAMILIES),
-                     help=f"comma-separated world families (default {','.join(FAMILIES)})")
+                     help=f"comma-separated world families (default {','.join(FAMILIES)}); "
+                     f"also {', '.join(UNSEEN)}, or unseen for all of those")
     nav.add_argument("--jobs", type=int, default=default_jobs(),
                      help="runs at a time (default: the number of cores)")
     nav.add_argument("--engine", choices=ENGINES, default="inprocess",
