@@ -125,7 +125,9 @@ def test_a_client_without_a_valid_certificate_cannot_connect(net: NetnsPair,
 
 
 def test_secured_stack_completes_the_mixed_scenario(net: NetnsPair, tmp_path: Path) -> None:
-    robot, server, _ = secured(net, tmp_path, MIXED, factor=4.0)
+    # 2x real time: at 4x a loaded machine delays the off-board planner's commands by
+    # whole ticks and the run stops being a test of the security setup.
+    robot, server, _ = secured(net, tmp_path, MIXED, factor=2.0)
     assert server is not None
     monitor = None
     started = time.monotonic()
@@ -136,7 +138,7 @@ def test_secured_stack_completes_the_mixed_scenario(net: NetnsPair, tmp_path: Pa
             "--jsonl", "--period", "0.2")],
             tmp_path / "monitor.log")
         server.up()
-        final = monitor.state("the run's result", reached, timeout=90)
+        final = monitor.state("the run's result", reached, timeout=150)
         assert final["result"]["outcome"] == "reached", final["result"]
         assert final["result"]["collided_with"] is None
         assert set(server.pids()) == {"perception", "tracking", "planner"}

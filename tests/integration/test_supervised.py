@@ -50,6 +50,9 @@ robot side's odometry reaching the monitor again."""
 
 LONGER_SCENARIO = LONG_SCENARIO.with_name("longer.yaml")
 
+OUTAGE_WAIT = 20.0
+"""s the kill test waits for the monitor to report the killed program's output stopped; a
+restart faster than the monitor's outage threshold shows no outage at all."""
 LOADED_WAIT = 90.0
 """s any one step of the loaded kill -9 test may take: with two busy loops beside a
 shared 2-core machine, a Python service's restart alone can take tens of seconds."""
@@ -144,12 +147,18 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
             spawned = time.time()
             back = monitor.event("alive", LOADED_WAIT, after=killed, service=program,
                                  alive=True)
-            stopped = monitor.wait(f"{output} stopping after the kill",
-                                   outage(monitor, output, killed), timeout=LOADED_WAIT)
-            flowing = monitor.event("flow", LOADED_WAIT, after=stopped["noticed"],
-                                    topic=output, flowing=True)
+            try:
+                stopped = monitor.wait(f"{output} stopping after the kill",
+                                       outage(monitor, output, killed), timeout=OUTAGE_WAIT)
+            except AssertionError:
+                # The output never paused long enough for the monitor to call it stopped:
+                # the restart beat the monitor's outage threshold; it flows from liveliness.
+                flowing_wall = back["wall"]
+            else:
+                flowing_wall = monitor.event("flow", LOADED_WAIT, after=stopped["noticed"],
+                                             topic=output, flowing=True)["wall"]
             times[program] = {"spawned": spawned - killed, "alive": back["wall"] - killed,
-                              "flowing": flowing["wall"] - killed}
+                              "flowing": flowing_wall - killed}
             measure(f"kill -9 {program}, {len(busy_machine)} busy loops -> data flowing "
                     f"again ({output})", times[program]["flowing"],
                     f"respawned {times[program]['spawned']:.3f} s, liveliness back "
@@ -160,7 +169,7 @@ def test_a_program_killed_with_sigkill_is_restarted_and_rejoins_without_the_othe
                 {p: before[p] for p in before if p != program}, "another program restarted"
             if program == "tracking":  # its state is rebuilt from the next messages
                 monitor.state("tracks again after the restart",
-                              has_tracks_after(flowing["wall"]), timeout=LOADED_WAIT)
+                              has_tracks_after(flowing_wall), timeout=LOADED_WAIT)
             x = snap["truth"]["x"] + 0.1
         final = monitor.state("the run's result", reached, timeout=6 * LOADED_WAIT)
         assert final["result"]["outcome"] == "reached", final["result"]
