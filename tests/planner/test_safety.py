@@ -30,7 +30,7 @@ def movers(*rows: tuple[float, float, float, float]) -> safety.Movers:
 
 
 def times(step: float = 0.2, horizon: float = 6.0) -> npt.NDArray[np.float64]:
-    return step * np.arange(1, round(horizon / step) + 1)
+    return step * np.arange(1, round(horizon / step) + 1, dtype=np.float64)
 
 
 def test_rollout_straight_speeds_up_within_accel() -> None:
