@@ -318,12 +318,31 @@ class PlannerState(Message):
 
 
 class GlobalPath(Message):
-    """The planner's global path, published whenever it is planned again."""
+    """The planner's global path: sent when it is planned again (or no way is found), and
+    sent again unchanged every few seconds so that a subscriber that joins late sees it.
+    A repeat is a new message (its own ``seq``, ``stamp`` the time it is sent) with the
+    same ``points``, ``reason`` and ``planned``: :meth:`repeats` tells it apart."""
 
     TYPE = "global_path"
     points: Rows2Array = Field(description="vertices [x, y] from the robot to the goal, m; "
                                "none when no way is known")
-    reason: str = Field("", max_length=100, description="why it was planned")
+    reason: str = Field("", max_length=100, description="why it was planned, or why no way "
+                        "is known")
+    planned: NonNegative | None = Field(
+        None, description="stamp at which this path was planned, s: a repeat keeps it; "
+        "absent: the message's own stamp")
+
+    @property
+    def planned_at(self) -> float:
+        """The stamp at which this path was planned."""
+        return self.stamp if self.planned is None else self.planned
+
+    def repeats(self, earlier: GlobalPath | None) -> bool:
+        """Whether this message is ``earlier`` sent again: the same plan (planned at the
+        same stamp, for the same reason) with the same vertices."""
+        return (earlier is not None and self.planned_at == earlier.planned_at
+                and self.reason == earlier.reason
+                and np.array_equal(self.points, earlier.points))
 
     @field_validator("points")
     @classmethod

@@ -1,7 +1,9 @@
 """Planner service: tracks in (they carry the robot pose at scan time) and the scan of
 the same stamp (for the map and the stop zone), one velocity command per scan out, plus
 an event for every decision that changes what the robot does, the planner's state for
-monitors, the global path whenever it changes and the map once a second.
+monitors, the global path (when it is planned again or no way is found, and again every
+``path_period`` while it stays the same, for subscribers that join late) and the map once a
+second.
 
 Joining the two halves of a stamp: a decision is made once both the track list and the
 scan of one stamp are in, whichever came first, so the result does not depend on their
@@ -16,6 +18,7 @@ import asyncio
 from collections import deque
 
 import numpy as np
+import numpy.typing as npt
 
 from zenav.schemas import keys
 from zenav.schemas.messages import (
@@ -100,6 +103,29 @@ class EventLog:
         return found
 
 
+PathKey = tuple[str, int, str]
+"""What a published global path stands for: ("path", plan number, "") or ("none", 0, why)."""
+
+NO_PATH = np.empty((0, 2))
+
+
+def current_path(planner: Planner) -> tuple[PathKey, npt.NDArray[np.float64], str] | None:
+    """The global path the planner goes by, as it is published: what it stands for, its
+    vertices and its reason. None before the planner has one; no vertices while the map
+    shows no way to the goal (the planner then keeps driving its old path, in recovery,
+    but that path is known to be blocked), and for good once the goal is unreachable."""
+    plan = planner.plan
+    if plan is not None and not plan.found:
+        why = plan.reason
+        if planner.recovery.unreachable:
+            why = f"goal unreachable: {why}"
+        return ("none", 0, why[:100]), NO_PATH, why[:100]
+    if planner.path is None:
+        return None
+    reason = plan.reason if plan is not None else "start"
+    return ("path", planner.plan_count, ""), planner.path, reason[:100]
+
+
 SCANS_KEPT = 8
 """Scans kept while their track lists are on the way."""
 
@@ -122,7 +148,8 @@ class Service:
         self.scans: dict[float, LaserScan] = {}  # the latest few, by stamp
         self.pending: TrackList | None = None  # a track list waiting for its scan
         self.timer: asyncio.TimerHandle | None = None
-        self.path_sent = 0  # the planner's plan_count last published
+        self.path_sent: PathKey | None = None  # what the last path published stood for
+        self.path_last: GlobalPath | None = None  # and that message, for its repeats
         self.map_sent = -1.0  # stamp of the last map published
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
@@ -173,13 +200,8 @@ class Service:
         self.publish_path_and_map(tracks.stamp)
 
     def publish_path_and_map(self, stamp: float) -> None:
-        planner = self.planner
-        if planner.path is not None and planner.plan_count != self.path_sent:
-            self.path_sent = planner.plan_count
-            reason = planner.plan.reason if planner.plan is not None else "start"
-            self.paths.publish(GlobalPath(stamp=stamp, seq=self.paths.next_seq(),
-                                          points=planner.path, reason=reason[:100]))
-        costmap = planner.costmap
+        self.publish_path(stamp)
+        costmap = self.planner.costmap
         if costmap is not None and stamp - self.map_sent >= self.params.map_period:
             self.map_sent = stamp
             values = costmap.values()
@@ -189,6 +211,25 @@ class Service:
                 origin=(float(costmap.origin[0]), float(costmap.origin[1])),
                 resolution=costmap.resolution, width=nx, height=ny,
                 cells=np.ascontiguousarray(values.T).ravel()))
+
+    def publish_path(self, stamp: float) -> None:
+        """A new global path (or the news that there is none) at once; the same again,
+        a new message stamped now, once ``path_period`` has passed since the last send."""
+        current = current_path(self.planner)
+        if current is None:
+            return
+        key, points, reason = current
+        last = self.path_last
+        if key != self.path_sent or last is None:
+            self.path_sent = key
+            self.path_last = GlobalPath(stamp=stamp, seq=self.paths.next_seq(), points=points,
+                                        reason=reason, planned=stamp)
+        elif last.stamp <= stamp < last.stamp + self.params.path_period - 1e-9:
+            return  # sent within the period (a clock that went back sends at once)
+        else:
+            self.path_last = last.model_copy(update={"stamp": stamp,
+                                                     "seq": self.paths.next_seq()})
+        self.paths.publish(self.path_last)
 
 
 if __name__ == "__main__":

@@ -205,6 +205,11 @@ class Params(MissionParams, StopZoneParams):
     )
     map_max_size: float = Field(200.0, gt=0, description="largest grid side, m")
     map_period: float = Field(1.0, gt=0, description="s between two published maps")
+    path_period: float = Field(
+        1.0, gt=0, description="s between two sends of an unchanged global path (or of "
+        "none, when no way is known): a new path is sent at once, and sent again at this "
+        "period so that a viewer or recorder that joins late has it within this time"
+    )
     scan_wait: float = Field(
         1.0, gt=0, description="wall s the planner waits for the scan of a track list's "
         "stamp before deciding without a map update; in real time the next track list "
