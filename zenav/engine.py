@@ -46,7 +46,9 @@ ENGINES = ("stack", "inprocess")
 acceptance path and the default), or this module's one process."""
 
 PATHS_KEPT = 10_000
-"""Global paths kept for run.png (the planner sends one each time it plans again)."""
+"""Global path messages buffered between two looks (the planner sends one each time it
+plans again and repeats it every ``path_period``; only the distinct ones are kept, see
+:func:`add_path`)."""
 
 RESULT_TIMEOUT = 3600.0
 """Loop-clock seconds the engine waits for the simulator's result. The loop's clock
@@ -146,7 +148,15 @@ class EngineRun:
     counters: dict[str, dict[str, Any]]
     path: GlobalPath | None = None  # the newest global path the planner published
     occupancy: OccupancyMap | None = None  # and the newest map
-    paths: list[GlobalPath] = field(default_factory=list)  # every path, oldest first
+    paths: list[GlobalPath] = field(default_factory=list)  # each distinct path, oldest first
+
+
+def add_path(paths: list[GlobalPath], path: GlobalPath) -> None:
+    """Append ``path`` to ``paths`` (oldest first) unless it repeats the last of them: the
+    planner sends an unchanged path again every ``path_period``, and each distinct path
+    is kept once, so a long run does not pile up copies."""
+    if not (paths and path.repeats(paths[-1])):
+        paths.append(path)
 
 
 def unique_events(payloads: list[bytes], key: str) -> list[PlannerEvent]:
@@ -198,6 +208,16 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
     live_events = bus.subscribe(k.of(keys.EVENTS), depth=100_000)
     paths = bus.subscribe(k.of(keys.PATH), depth=PATHS_KEPT)
     maps = bus.subscribe(k.of(keys.MAP), depth=1)
+    heard: list[GlobalPath] = []
+
+    async def take_paths() -> None:  # as they come: the repeats of a long run add up
+        while True:
+            payload = (await paths.get())[1]
+            with contextlib.suppress(DecodeError):
+                add_path(heard, decode(payload, GlobalPath, k.of(keys.PATH),
+                                       keys.PATH.max_bytes))
+
+    path_taker = asyncio.create_task(take_paths(), name="run:paths")
     spins: dict[str, asyncio.Task[None]] = {}
     for name in SERVICE_ORDER:
         add_run(name, nodes[name], services[name])
@@ -227,11 +247,10 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
                            "handler_errors": node.handler_errors}
                     for name, node in nodes.items()}
         occupancy = None
-        heard: list[GlobalPath] = []
-        while paths.pending():
+        while (taken := paths.take()) is not None:  # those the path taker has not had
             with contextlib.suppress(DecodeError):
-                heard.append(decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
-                                    keys.PATH.max_bytes))
+                add_path(heard, decode(taken[1], GlobalPath, k.of(keys.PATH),
+                                       keys.PATH.max_bytes))
         while maps.pending():
             with contextlib.suppress(DecodeError):
                 occupancy = decode((await maps.get())[1], OccupancyMap, k.of(keys.MAP),
@@ -239,6 +258,7 @@ async def _run_services(params: Mapping[str, Mapping[str, Any]], planner: str,
         return EngineRun(result, unique_events(payloads, k.of(keys.EVENTS)), counters,
                          heard[-1] if heard else None, occupancy, heard)
     finally:
+        path_taker.cancel()
         # The simulator first, so that it does not log the others going away.
         nodes["simulator"].request_stop()
         await asyncio.gather(spins["simulator"], return_exceptions=True)

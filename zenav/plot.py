@@ -97,7 +97,8 @@ def draw_earlier_paths(ax: Any, paths: Sequence[GlobalPath]) -> None:
         xs, ys = earlier.points[:, 0], earlier.points[:, 1]
         label = None
         if k <= EARLIER_LISTED:
-            label = f"path {k} (t={earlier.stamp:.1f} s, {earlier.reason or 'no reason'})"
+            label = (f"path {k} (t={earlier.planned_at:.1f} s, "
+                     f"{earlier.reason or 'no reason'})")
         elif k == EARLIER_LISTED + 1:
             label = f"paths {k}-{len(drawn)}"
         ax.plot(xs, ys, ls=":", color=EARLIER_PATH_COLOUR, lw=0.9, alpha=0.8, label=label)
@@ -161,9 +162,13 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
         if record.get("path"):
             px, py = zip(*record["path"], strict=True)
             last = "global path (last)" if not paths else (
-                f"global path (last: t={paths[-1].stamp:.1f} s, "
+                f"global path (last: t={paths[-1].planned_at:.1f} s, "
                 f"{paths[-1].reason or 'no reason'})")
             ax.plot(px, py, ls="--", color="tab:green", lw=1, label=last)
+        elif "path" in record:  # the planner's last word was that it knows no way
+            why = f", {paths[-1].reason}" if paths and paths[-1].reason else ""
+            ax.plot([], [], ls="--", color="tab:green", lw=1,
+                    label=f"global path (last): none{why}")
         else:
             _global_path(ax, scenario, label="global path")
         traj = record["trajectory"]
@@ -247,7 +252,7 @@ def draw_experiment(scenario: Scenario, record: dict[str, Any], path: Path,
         if record.get("path"):
             px, py = zip(*record["path"], strict=True)
             ax.plot(px, py, ls="--", color="tab:green", lw=1, label="global path (last)")
-        else:
+        elif "path" not in record:  # an empty one: the planner's last word was no way
             _global_path(ax, scenario, label="global path")
         ax.plot(traj[:, 1], traj[:, 2], color="tab:blue", lw=1.6, label="trajectory")
         points = decision_points(record)

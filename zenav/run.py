@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from zenav.engine import PATHS_KEPT
+from zenav.engine import PATHS_KEPT, add_path
 from zenav.launch import Stack
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
@@ -118,7 +118,7 @@ class Heard:
 
     path: GlobalPath | None = None
     occupancy: OccupancyMap | None = None
-    paths: list[GlobalPath] = field(default_factory=list)  # every path, oldest first
+    paths: list[GlobalPath] = field(default_factory=list)  # each distinct path, oldest first
 
 
 async def _collect(stack: Stack, progress_timeout: float, record: Path | None = None,
@@ -226,12 +226,13 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
 
 async def _take_paths_and_map(k: Keys, paths: Subscription, maps: Latest,
                               heard: Heard) -> None:
-    """Every path and the newest map that came since the last look, into ``heard``."""
+    """The paths and the newest map that came since the last look, into ``heard``: each
+    distinct path once (the planner repeats an unchanged one every ``path_period``)."""
     while paths.pending():
         with contextlib.suppress(DecodeError):
             heard.path = decode((await paths.get())[1], GlobalPath, k.of(keys.PATH),
                                 keys.PATH.max_bytes)
-            heard.paths.append(heard.path)
+            add_path(heard.paths, heard.path)
     occupancy = maps.take()
     if occupancy is not None:
         with contextlib.suppress(DecodeError):

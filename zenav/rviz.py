@@ -4,8 +4,10 @@ Read-only, from any host: it follows zenav's tracks and planner state and publis
 ``visualization_msgs/msg/MarkerArray`` on ``/zenav/markers`` (a cylinder per tracked
 obstacle coloured by type, a velocity arrow per mover, the planner's scenario letter and
 action as text above the robot), in the odometry frame, and the planner's global path
-(``planner/path``) as ``nav_msgs/msg/Path`` on ``/zenav/plan`` whenever it is planned
-again, and its occupancy map (``planner/map``, about once a second) as
+(``planner/path``) as ``nav_msgs/msg/Path`` on ``/zenav/plan`` as the planner sends it
+(when it plans again, and the same path again about once a second, so that an RViz
+started late shows it; a Path with no poses when no way is known), and
+its occupancy map (``planner/map``, about once a second) as
 ``nav_msgs/msg/OccupancyGrid`` on ``/zenav/map``. In RViz: Add > By topic >
 /zenav/markers, /zenav/plan and /zenav/map (the map display's durability: volatile).
 """
@@ -38,7 +40,8 @@ from zenav.tooling import (
 
 class RvizView:
     """Tracks and planner state in, MarkerArray out (one per track list); global paths
-    in, Path out (one per path); maps in, OccupancyGrid out (one per map)."""
+    in, Path out (one per path message, repeats included); maps in, OccupancyGrid out
+    (one per map)."""
 
     def __init__(self, bus: Bus, robot_id: str, *, domain_id: int = 0,
                  topic: str = "/zenav/markers", frame: str = "odom",

@@ -21,6 +21,7 @@ from tests.integration.livestack import (
     zenav,
 )
 from zenav.bag.mcapfile import read_bag
+from zenav.engine import add_path
 from zenav.launch import free_port_block
 from zenav.schemas.codec import decode
 from zenav.schemas.messages import GlobalPath
@@ -81,9 +82,13 @@ def test_the_monitor_shows_the_global_path_and_the_map_of_a_live_stack(tmp_path:
     assert 0 < occupancy["occupied_fraction"] < occupancy["known_fraction"] <= 1
     events = [e for e in monitor.events if e["event"] == "path"]
     assert [e["reason"] for e in events][:1] == ["start"]
-    # What the monitor showed is what the planner published: every path, in order.
+    # What the monitor showed is what the planner published: every distinct path, in
+    # order (the planner also sends an unchanged path again every path_period).
     recorded = [decode(r.payload, GlobalPath) for r in read_bag(recording, {"planner/path"})]
-    assert [(p.stamp, p.reason, len(p.points)) for p in recorded][:len(events)] == [
+    distinct: list[GlobalPath] = []
+    for sent in recorded:
+        add_path(distinct, sent)
+    assert [(p.planned_at, p.reason, len(p.points)) for p in distinct][:len(events)] == [
         (e["stamp"], e["reason"], e["waypoints"]) for e in events]
-    shown = next(p for p in recorded if p.stamp == path["stamp"])
+    shown = next(p for p in recorded if p.planned_at == path["stamp"])
     assert [[round(float(x), 3), round(float(y), 3)] for x, y in shown.points] == path["points"]

@@ -129,7 +129,46 @@ def test_a_path_with_no_way_is_shown_as_such():
     assert snap["path"]["to_go"] is None and snap["path"]["points"] == []
     console = Console(file=io.StringIO(), width=140, record=True, color_system=None)
     console.print(render(model, T0 + 4.5))
-    assert "global path: no way known (t=4.0 s, retry" in console.export_text()
+    assert ("global path: no way known since t=4.0 s (retry), heard 0.5 s ago"
+            in console.export_text())
+
+
+def test_repeats_of_a_path_refresh_it_but_are_not_new_plans():
+    """The planner sends an unchanged path again every path_period, stamped when sent:
+    the monitor keeps it fresh, counts one plan and reports one ``path`` event, and a
+    monitor that joined late (its first message a repeat) shows when it was planned."""
+    points = np.array([[2.0, 3.0], [8.0, 3.0]])
+    model = MonitorModel("r1")
+    feed(model, "planner/path", GlobalPath(stamp=0.5, seq=0, points=points, reason="start",
+                                           planned=0.5), 0.5)
+    for k in (1, 2, 3):  # the repeats, one a second, stamped when sent
+        feed(model, "planner/path", GlobalPath(stamp=0.5 + k, seq=k, points=points,
+                                               reason="start", planned=0.5), 0.5 + k)
+    snap = model.snapshot(T0 + 3.75)["path"]
+    assert snap["plans"] == 1 and snap["stamp"] == 0.5 and snap["sent"] == 3.5
+    assert snap["age"] == pytest.approx(0.25) and snap["seq"] == 3
+    assert [e.data["stamp"] for e in model.drain_events() if e.kind == "path"] == [0.5]
+    # The same vertices planned again (a new plan stamp) is a new plan; so is "no way".
+    feed(model, "planner/path", GlobalPath(stamp=4.5, seq=4, points=points, reason="replan",
+                                           planned=4.5), 4.5)
+    none = np.zeros((0, 2))
+    for k in (5, 6):
+        feed(model, "planner/path", GlobalPath(stamp=float(k + 0.5), seq=k, points=none,
+                                               reason="no way to the goal", planned=5.5),
+             k + 0.5)
+    snap = model.snapshot(T0 + 7.0)["path"]
+    assert snap["plans"] == 3 and snap["found"] is False and snap["stamp"] == 5.5
+    assert [(e.data["reason"], e.data["waypoints"]) for e in model.drain_events()
+            if e.kind == "path"] == [("replan", 2), ("no way to the goal", 0)]
+    # A monitor started late: its first message is a repeat, planned long before.
+    late = MonitorModel("r1")
+    feed(late, "planner/path", GlobalPath(stamp=3.5, seq=3, points=points, reason="start",
+                                          planned=0.5), 3.5)
+    assert late.snapshot(T0 + 3.5)["path"]["stamp"] == 0.5
+    console = Console(file=io.StringIO(), width=150, record=True, color_system=None)
+    console.print(render(late, T0 + 4.0))
+    assert ("global path: 6.00 m, 2 waypoints, planned at t=0.5 s (start), heard 0.5 s "
+            "ago, 1 plan heard") in console.export_text()
 
 
 def test_the_map_in_characters_marks_occupied_free_and_unknown():
@@ -190,8 +229,8 @@ def test_the_screen_shows_path_map_and_the_view_round_the_robot():
     console = Console(file=io.StringIO(), width=150, record=True, color_system=None)
     console.print(render(model, T0 + 2.6))
     text = console.export_text()
-    assert ("global path: 5.00 m, 2 waypoints, planned 1.0 s ago at t=1.5 s (off the path), "
-            "1 heard; to go 4.00 m, off it 0.00 m") in text
+    assert ("global path: 5.00 m, 2 waypoints, planned at t=1.5 s (off the path), heard 1.0 s "
+            "ago, 1 plan heard; to go 4.00 m, off it 0.00 m") in text
     assert ("map: 100 x 80 cells of 0.10 m (10.0 x 8.0 m), known 75.0 %, occupied 1.25 %, "
             "t=2.0 s, 0.5 s old") in text
     assert "map round the robot (0.25 m per column, 0.5 m per row)" in text

@@ -7,7 +7,7 @@ import math
 import statistics
 from collections import Counter, OrderedDict, deque
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -150,12 +150,14 @@ def along_path(points: npt.NDArray[np.float64], x: float, y: float) -> tuple[flo
 
 @dataclass(frozen=True)
 class PathState:
-    """The planner's newest global path as the monitor heard it."""
+    """The planner's newest global path as the monitor heard it. The planner sends an
+    unchanged path again every ``path_period``: a repeat refreshes ``message`` and
+    ``received`` but is not another plan."""
 
-    message: GlobalPath
-    received: float  # wall time
+    message: GlobalPath  # the newest message of this plan (a repeat or the first send)
+    received: float  # wall time it was heard
     length: float  # m
-    plans: int  # paths heard since the monitor started
+    plans: int  # distinct paths heard since the monitor started
 
     @property
     def found(self) -> bool:
@@ -318,10 +320,13 @@ class MonitorModel:
             self.emit(now, "decision", scenario=message.scenario, action=message.action,
                       obstacle=message.obstacle, kind=message.kind, stamp=message.stamp)
         elif isinstance(message, GlobalPath):
+            if self.path is not None and message.repeats(self.path.message):
+                self.path = replace(self.path, message=message, received=now)
+                return
             plans = 1 if self.path is None else self.path.plans + 1
             self.path = PathState(message, now, path_length(message.points), plans)
             self.emit(now, "path", reason=message.reason, waypoints=len(message.points),
-                      length=round(self.path.length, 3), stamp=message.stamp)
+                      length=round(self.path.length, 3), stamp=message.planned_at)
         elif isinstance(message, OccupancyMap):
             self.map = MapState.of(message, now)
         elif isinstance(message, RunResult):
@@ -409,8 +414,9 @@ class MonitorModel:
         if robot is not None and path.found:
             along, off = along_path(points, *robot)
             to_go, off_path = round(along, 3), round(off, 3)
-        return {"stamp": path.message.stamp, "seq": path.message.seq,
-                "reason": path.message.reason, "waypoints": len(points),
+        return {"stamp": path.message.planned_at, "sent": path.message.stamp,
+                "seq": path.message.seq, "reason": path.message.reason,
+                "waypoints": len(points),
                 "length": round(path.length, 3), "found": path.found,
                 "goal": [round(float(v), 3) for v in points[-1]] if path.found else None,
                 "age": round(now - path.received, 3), "plans": path.plans,

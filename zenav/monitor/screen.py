@@ -17,13 +17,15 @@ def _ms(value: float | int | None) -> str:
 def path_line(path: dict[str, Any] | None) -> str:
     """One line on the global path, from the snapshot's ``path``."""
     if path is None:
-        return "global path: none heard yet (the planner sends it when it plans again)"
+        return ("global path: none heard yet (the planner sends it when it plans again and "
+                "repeats it about once a second)")
     if not path["found"]:
-        return (f"global path: no way known (t={path['stamp']:.1f} s, {path['reason']}, "
-                f"{path['age']:.1f} s ago)")
+        return (f"global path: no way known since t={path['stamp']:.1f} s "
+                f"({path['reason']}), heard {path['age']:.1f} s ago")
+    plans = "1 plan" if path["plans"] == 1 else f"{path['plans']} plans"
     line = (f"global path: {path['length']:.2f} m, {path['waypoints']} waypoints, planned "
-            f"{path['age']:.1f} s ago at t={path['stamp']:.1f} s "
-            f"({path['reason'] or 'no reason given'}), {path['plans']} heard")
+            f"at t={path['stamp']:.1f} s ({path['reason'] or 'no reason given'}), heard "
+            f"{path['age']:.1f} s ago, {plans} heard")
     if path["to_go"] is not None:
         line += f"; to go {path['to_go']:.2f} m, off it {path['off_path']:.2f} m"
     return line
