@@ -319,9 +319,10 @@ class PlannerState(Message):
 
 class GlobalPath(Message):
     """The planner's global path: sent when it is planned again (or no way is found), and
-    sent again unchanged every few seconds so that a subscriber that joins late sees it.
-    A repeat is a new message (its own ``seq``, ``stamp`` the time it is sent) with the
-    same ``points``, ``reason`` and ``planned``: :meth:`repeats` tells it apart."""
+    sent again unchanged every ``path_period`` (planner parameter, 1 s) so that a
+    subscriber that joins late has it. A repeat is a new message (its own ``seq``,
+    ``stamp`` the time it is sent) with the same ``points``, ``reason`` and ``planned``:
+    :meth:`repeats` tells it apart."""
 
     TYPE = "global_path"
     points: Rows2Array = Field(description="vertices [x, y] from the robot to the goal, m; "

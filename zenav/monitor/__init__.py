@@ -35,7 +35,6 @@ Events (``drain_events``) are state changes with the wall time they happened:
 ``alive`` (a token appeared or went), ``flow`` (a topic stopped or started), ``base``
 (the base command's reason changed, e.g. to ``stale``), ``motion`` (the robot started or
 came to a standstill), ``planner`` (scenario or action changed), ``decision`` (a planner
-event), ``path`` (a new global path heard, not a repeat: why, waypoints, length, the stamp it was
-planned at), ``result`` (the simulated
-run ended).
+event), ``path`` (a new global path heard, not a repeat: why, waypoints, length, the stamp
+it was planned at), ``result`` (the simulated run ended).
 """
