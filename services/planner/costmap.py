@@ -3,7 +3,9 @@
 Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
 
 - every beam clears the cells it passes through (ray tracing, all beams at once: the
-  points every half cell along each beam, up to its return or the laser's reach);
+  points every half cell along each beam, up to its return or the laser's reach), but
+  not a cell another return of the same scan falls in (marking wins, as in Nav2's
+  obstacle layer);
 - the cell of each return is marked occupied, unless the return falls inside the disc
   of a track typed dynamic (movers are the local layer's business, not the map's); it
   counts as an obstacle once it has stayed occupied for ``confirm`` seconds, so a mover
@@ -190,10 +192,6 @@ class Costmap:
         fx *= ny
         fx += fy  # the flat index, exact: whole numbers far below 2**53
         flat = fx[along].astype(np.intp)
-        seen, occupied = _flat(self.seen), _flat(self.occupied)
-        seen[flat] = stamp
-        cleared = occupied[flat]
-        occupied[flat] = False
         # Hits, except those on a mover.
         marks = ends[hit]
         if movers and len(marks):
@@ -203,6 +201,17 @@ class Costmap:
             marks = marks[(gap > self.resolution).all(axis=1)]
         hits = self.cell_of(marks)
         hits = hits[self.inside(hits)]
+        # A cell a return of this scan falls in is not cleared by this scan: along a
+        # straight wall, the beams that meet it at a grazing angle pass through the face
+        # cells the others return from, and clearing them would restart their
+        # confirmation on every scan (a wall seen side-on would never be confirmed).
+        returned = np.zeros(nx * ny, dtype=bool)
+        returned[hits[:, 0] * ny + hits[:, 1]] = True
+        flat = flat[~returned[flat]]
+        seen, occupied = _flat(self.seen), _flat(self.occupied)
+        seen[flat] = stamp
+        cleared = occupied[flat]
+        occupied[flat] = False
         newly = ~self.occupied[hits[:, 0], hits[:, 1]]
         self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
         self.seen[hits[:, 0], hits[:, 1]] = stamp

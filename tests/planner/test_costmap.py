@@ -72,3 +72,16 @@ def test_the_grid_grows_to_hold_what_is_seen_and_where_the_robot_goes() -> None:
     cm.update(scan_of((0.0, 0.0, math.pi / 2), boxes=[(-0.5, 6.0, 0.5, 6.2)]), 0.0)
     assert cm.shape[1] > before[1]
     assert value_at(cm, 0.0, 6.05) == OCCUPIED
+
+
+def test_a_straight_wall_seen_side_on_from_close_by_is_confirmed_along_its_face() -> None:
+    # The robot stands 0.33 m from a long wall, facing it a little askew: the beams far
+    # to either side meet the wall at a grazing angle and pass through the face cells
+    # that the beams nearer the normal return from. Those returns must still confirm.
+    cm = fresh(confirm=1.0)
+    wall = [(0.33, -3.0, 0.53, 3.0)]
+    for k in range(11):  # 1 s of scans at 10 Hz, noisy as the simulated laser
+        cm.update(scan_of((0.0, 0.0, 0.2), boxes=wall, noise=0.01, seed=k), 0.1 * k)
+    face = np.array([[0.35, y] for y in np.arange(-1.25, 1.3, 0.1)])
+    assert cm.lethal_at(face).all()
+    assert cm.blocked_at(np.array([[0.05, 0.0]]))[0]  # and the robot is in its inflation

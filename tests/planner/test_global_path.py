@@ -88,3 +88,35 @@ def test_random_gaps_and_cups_are_found_whatever_their_place(seed: int) -> None:
                     width=size, depth=float(rng.uniform(0.8, 2.0))))
     plan = plan_path(cm, START, GOAL)
     assert plan.found and clear_of_blocked(cm, plan.points), size
+
+
+def crosses(points: np.ndarray, box: tuple[float, float, float, float]) -> bool:
+    """Whether the polyline passes through the box (sampled every centimetre)."""
+    for a, b in itertools.pairwise(points):
+        t = np.linspace(0.0, 1.0, max(2, math.ceil(float(np.hypot(*(b - a))) / 0.01)))
+        p = a[None, :] + t[:, None] * (b - a)[None, :]
+        if ((p[:, 0] >= box[0]) & (p[:, 0] <= box[2]) & (p[:, 1] >= box[1])
+                & (p[:, 1] <= box[3])).any():
+            return True
+    return False
+
+
+@pytest.mark.parametrize("heading", [-0.4, 0.0, 0.5])
+def test_pressed_against_a_cups_back_wall_the_path_leaves_by_the_mouth(heading: float) -> None:
+    # The robot drove into a cup and stands 0.3 m from its back wall, the goal straight
+    # behind that wall. Re-planned from there, the path must go out of the cup's mouth
+    # and round it, not through the back wall the laser sees side-on from close by.
+    walls = cup(5.03, 4.0, width=2.2, depth=2.0)  # its face inside a cell, not on an edge
+    back = walls[0]
+    robot = (4.73, 3.7, heading)
+    approach = [(x, 4.0 + 0.1 * x - 0.3, 0.0) for x in np.arange(1.0, 4.73, 0.35)]
+    cm = Costmap((0.0, 4.0), (8.0, 4.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=1.0, padding=3.0, max_size=100.0)
+    stamp = 0.0
+    for k, pose in enumerate(approach + [robot] * 15):
+        cm.update(scan_of(pose, boxes=walls, noise=0.01, seed=k), stamp)
+        stamp += 0.1
+    plan = plan_path(cm, np.array(robot[:2]), GOAL)
+    assert plan.found
+    assert not crosses(plan.points, back)
+    assert min(p[0] for p in plan.points) < 5.03 - 2.0  # out by the mouth
