@@ -12,7 +12,10 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   beyond perception's window (no track, no type) leaves no wake of marks: its front moves
   on to new cells before they are confirmed, and the beams clear the cells it left;
 - a cell keeps what it was last seen as for ``decay`` seconds, then is unknown again;
-- the planner treats unknown cells as free (optimistic, as Nav2's ``allow_unknown``);
+- the planner treats unknown cells as free (optimistic, as Nav2's ``allow_unknown``), but
+  not the space beyond the grid: the global path never leaves it (the grid holds start,
+  goal, the robot and every return with half the padding to spare; only ``max_size``
+  can leave one out);
 - occupied cells are inflated by the robot radius plus a margin with a Euclidean distance
   transform (scipy.ndimage), so a path through the free cells keeps the robot's disc
   clear of everything the map holds.
@@ -280,11 +283,13 @@ class Costmap:
         assert self._gap is not None
         return self._gap
 
-    def blocked_at(self, points: Vec) -> npt.NDArray[np.bool_]:
-        """Whether each point (n, 2) lies in a blocked cell (outside the grid: free)."""
+    def blocked_at(self, points: Vec, *, outside: bool = False) -> npt.NDArray[np.bool_]:
+        """Whether each point (n, 2) lies in a blocked cell; a point beyond the grid is
+        ``outside`` (free by default: the local checks near the robot, which the grid
+        always holds with room to spare; the global path passes True)."""
         cells = self.cell_of(points)
         ok = self.inside(cells)
-        out = np.zeros(len(cells), dtype=bool)
+        out = np.full(len(cells), outside, dtype=bool)
         grid = self.blocked()
         out[ok] = grid[cells[ok, 0], cells[ok, 1]]
         return out

@@ -5,7 +5,8 @@ A grid search (Dijkstra on the 8-connected free cells, ``field.grid_distances``)
 the goal gives every cell's distance to go and the way there; the robot's cell is
 followed down that way, and then, in the manner of Theta*, each vertex is joined to the
 farthest later one it sees in a straight line through free cells, so the path bends only
-where an obstacle makes it. Unknown cells count as free. With nothing known the path is
+where an obstacle makes it. Unknown cells count as free; the space beyond the grid does
+not (there is no map of it: the path stays on the grid). With nothing known the path is
 the straight line from the robot to the goal, exactly the paper's global path.
 """
 
@@ -53,14 +54,14 @@ def _nearest_free(free: BoolGrid, cell: tuple[int, int], radius: int) -> tuple[i
 
 def visible(free: BoolGrid, costmap: Costmap, a: Vec, b: Vec) -> bool:
     """Whether the straight segment a-b passes through free cells only (sampled every
-    quarter cell; points outside the grid count as free)."""
+    quarter cell; a point beyond the grid is not free: there is no map of it)."""
     length = float(np.hypot(*(b - a)))
     count = max(2, math.ceil(length / (costmap.resolution / 4)) + 1)
     t = np.linspace(0.0, 1.0, count)[:, None]
     points = a[None, :] + t * (b - a)[None, :]
     cells = costmap.cell_of(points)
     ok = costmap.inside(cells)
-    return bool(free[cells[ok, 0], cells[ok, 1]].all())
+    return bool(ok.all() and free[cells[:, 0], cells[:, 1]].all())
 
 
 def _cost_along(cost: npt.NDArray[np.float64], costmap: Costmap, points: Vec) -> float:
@@ -126,10 +127,13 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
     to an obstacle than the margin, and a goal may lie near a wall. A goal on an
     occupied cell, or one cut off, has no way (``found`` is False)."""
     costmap.grow_to(np.vstack([start, goal]), costmap.padding / 2)
+    ends = costmap.cell_of(np.vstack([start, goal]))
+    if not costmap.inside(ends).all():  # the grid at its largest cannot hold them
+        return GlobalPlan(np.empty((0, 2)), math.inf, "start or goal beyond the map")
     free = ~costmap.blocked()
     ny = free.shape[1]
-    si, sj = (int(v) for v in costmap.cell_of(start[None, :])[0])
-    gi, gj = (int(v) for v in costmap.cell_of(goal[None, :])[0])
+    si, sj = (int(v) for v in ends[0])
+    gi, gj = (int(v) for v in ends[1])
     s_cell, g_cell = (si, sj), (gi, gj)
     if costmap.lethal_at(goal[None, :])[0]:
         return GlobalPlan(np.empty((0, 2)), math.inf, "goal occupied")
@@ -199,7 +203,7 @@ def point_at(points: Vec, s: float) -> Vec:
 
 def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float) -> float | None:
     """Arc length of the first point of the path, at or beyond ``from_s``, that lies in
-    a blocked cell; None if the rest of the path is free."""
+    a blocked cell or beyond the grid; None if the rest of the path is free."""
     total = float(arc_lengths(points)[-1])
     if from_s >= total:
         return None
@@ -207,5 +211,5 @@ def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float) -> 
     lengths = arc_lengths(points)
     samples = np.column_stack([np.interp(s, lengths, points[:, 0]),
                                np.interp(s, lengths, points[:, 1])])
-    hit = costmap.blocked_at(samples)
+    hit = costmap.blocked_at(samples, outside=True)
     return float(s[int(np.argmax(hit))]) if hit.any() else None

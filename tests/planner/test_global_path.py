@@ -12,7 +12,7 @@ import pytest
 
 from tests.planner.scans import cup, scan_of, wall_with_gap
 from zenav.services.planner.costmap import Costmap
-from zenav.services.planner.global_path import plan_path, visible
+from zenav.services.planner.global_path import first_blocked, plan_path, visible
 
 START = np.array([0.0, 4.0])
 GOAL = np.array([8.0, 4.0])
@@ -120,3 +120,22 @@ def test_pressed_against_a_cups_back_wall_the_path_leaves_by_the_mouth(heading: 
     assert plan.found
     assert not crosses(plan.points, back)
     assert min(p[0] for p in plan.points) < 5.03 - 2.0  # out by the mouth
+
+
+def test_the_space_beyond_the_grid_is_no_way_for_the_global_path() -> None:
+    # A grid held to 6 m a side cannot grow to a goal 12 m away: there is no map of the
+    # space between, so no path through it (before: the straight line, as if free).
+    cm = Costmap((0.0, 0.0), (1.0, 0.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=2.0, max_size=6.0)
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=[(2.0, 1.0, 2.2, 2.0)]), 0.0)
+    far = np.array([12.0, 0.0])
+    assert not plan_path(cm, np.zeros(2), far).found
+    nx, ny = cm.shape
+    top = cm.origin + np.array([nx, ny]) * cm.resolution
+    inside, beyond = np.array([0.0, 0.0]), np.array([top[0] + 1.0, 0.0])
+    free = ~cm.blocked()
+    assert visible(free, cm, inside, np.array([top[0] - 0.5, 0.0]))
+    assert not visible(free, cm, inside, beyond)
+    # A path that runs off the grid is blocked from where it leaves it.
+    leaves = first_blocked(cm, np.vstack([inside, beyond]), 0.0, 0.1)
+    assert leaves is not None and leaves == pytest.approx(top[0], abs=0.11)
