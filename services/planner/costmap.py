@@ -271,6 +271,10 @@ class Costmap:
         self._gap = gap
         return lethal, blocked
 
+    def lethal_grid(self) -> BoolGrid:
+        """The lethal cells the inflation was made from (cached with it)."""
+        return self._refresh()[0]
+
     def blocked(self) -> BoolGrid:
         """Cells whose centre lies within the inflation distance of an occupied cell:
         the robot's centre must not enter them."""

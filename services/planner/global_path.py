@@ -37,8 +37,12 @@ class GlobalPlan:
         return len(self.points) >= 2
 
 
-def _nearest_free(free: BoolGrid, cell: tuple[int, int], radius: int) -> tuple[int, int] | None:
-    """The free cell nearest ``cell`` within ``radius`` cells, or None."""
+def _nearest_free(free: BoolGrid, cell: tuple[int, int], radius: int,
+                  lethal: BoolGrid | None = None) -> tuple[int, int] | None:
+    """The free cell nearest ``cell`` within ``radius`` cells, or None. With ``lethal``
+    (the occupied cells), only a free cell that ``cell`` sees in a straight line through
+    no occupied cell counts: next to a thin wall the nearest free cell may lie on its
+    far side, and the path joins it straight."""
     nx, ny = free.shape
     i0, j0 = cell
     lo_i, hi_i = max(0, i0 - radius), min(nx, i0 + radius + 1)
@@ -47,9 +51,23 @@ def _nearest_free(free: BoolGrid, cell: tuple[int, int], radius: int) -> tuple[i
     if not window.any():
         return None
     ii, jj = np.nonzero(window)
-    d = (ii + lo_i - i0) ** 2 + (jj + lo_j - j0) ** 2
-    k = int(np.argmin(d))
-    return int(ii[k] + lo_i), int(jj[k] + lo_j)
+    ii, jj = ii + lo_i, jj + lo_j
+    d = (ii - i0) ** 2 + (jj - j0) ** 2
+    for k in np.argsort(d, kind="stable"):
+        there = (int(ii[k]), int(jj[k]))
+        if lethal is None or not _crosses(lethal, cell, there):
+            return there
+    return None
+
+
+def _crosses(grid: BoolGrid, a: tuple[int, int], b: tuple[int, int]) -> bool:
+    """Whether the straight line between the centres of cells ``a`` and ``b`` passes
+    through a True cell of ``grid`` (sampled every quarter cell), ``a`` itself aside."""
+    steps = max(1, 4 * max(abs(b[0] - a[0]), abs(b[1] - a[1])))
+    t = np.linspace(0.0, 1.0, steps + 1)[1:]
+    i = np.floor(a[0] + 0.5 + t * (b[0] - a[0])).astype(np.int64)
+    j = np.floor(a[1] + 0.5 + t * (b[1] - a[1])).astype(np.int64)
+    return bool(grid[i, j].any())
 
 
 def visible(free: BoolGrid, costmap: Costmap, a: Vec, b: Vec) -> bool:
@@ -123,8 +141,9 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
     """The any-angle shortest way from ``start`` to ``goal`` round the blocked cells.
 
     A start or goal inside a blocked (inflated) cell but not on an occupied one is joined
-    to the nearest free cell within the inflation distance: the robot may stand closer
-    to an obstacle than the margin, and a goal may lie near a wall. A goal on an
+    to the nearest free cell within the inflation distance (twice that for the start)
+    that it sees past every occupied cell: the robot may stand closer to an obstacle
+    than the margin, and a goal may lie near a wall. A goal on an
     occupied cell, or one cut off, has no way (``found`` is False)."""
     costmap.grow_to(np.vstack([start, goal]), costmap.padding / 2)
     ends = costmap.cell_of(np.vstack([start, goal]))
@@ -138,8 +157,9 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
     if costmap.lethal_at(goal[None, :])[0]:
         return GlobalPlan(np.empty((0, 2)), math.inf, "goal occupied")
     reach = max(1, math.ceil(costmap.inflation / costmap.resolution) + 1)
-    g_free = g_cell if free[g_cell] else _nearest_free(free, g_cell, reach)
-    s_free = s_cell if free[s_cell] else _nearest_free(free, s_cell, 2 * reach)
+    lethal = costmap.lethal_grid()
+    g_free = g_cell if free[g_cell] else _nearest_free(free, g_cell, reach, lethal)
+    s_free = s_cell if free[s_cell] else _nearest_free(free, s_cell, 2 * reach, lethal)
     if g_free is None or s_free is None:
         return GlobalPlan(np.empty((0, 2)), math.inf, "no free cell at start or goal")
     if free.all() or (visible(free, costmap, start, goal) and s_free == s_cell

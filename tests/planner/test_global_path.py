@@ -139,3 +139,20 @@ def test_the_space_beyond_the_grid_is_no_way_for_the_global_path() -> None:
     # A path that runs off the grid is blocked from where it leaves it.
     leaves = first_blocked(cm, np.vstack([inside, beyond]), 0.0, 0.1)
     assert leaves is not None and leaves == pytest.approx(top[0], abs=0.11)
+
+
+def test_a_start_in_the_inflation_is_joined_to_free_space_on_its_side_of_a_thin_wall() -> None:
+    # The robot stands in a slot narrower than the inflation allows, 0.4 m from its
+    # mouth, between two thin walls with open space beyond them. The free cells just
+    # across a wall are nearer than those out of the mouth; the path must leave by the
+    # mouth, not start behind a wall.
+    walls = [(-0.8, 0.28, 3.0, 0.36), (-0.8, -0.36, 3.0, -0.28)]
+    cm = Costmap((0.0, 0.0), (4.0, 0.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=3.0, max_size=100.0)
+    robot = np.array([-0.4, 0.0])
+    for k, heading in enumerate((0.0, math.pi, math.pi / 2, -math.pi / 2)):
+        cm.update(scan_of((-0.4, 0.0, heading), boxes=walls), 0.1 * k)
+    assert cm.blocked_at(robot[None, :])[0]
+    plan = plan_path(cm, robot, np.array([-3.0, 2.0]))
+    assert plan.found
+    assert not any(crosses(plan.points, box) for box in walls)
