@@ -98,6 +98,7 @@ class Costmap:
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None
         self._scratch = np.empty(0)  # reused by the ray tracing
+        self._returned = np.zeros(0, dtype=bool)  # per flat cell: a return of this scan
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -208,9 +209,12 @@ class Costmap:
         # straight wall, the beams that meet it at a grazing angle pass through the face
         # cells the others return from, and clearing them would restart their
         # confirmation on every scan (a wall seen side-on would never be confirmed).
-        returned = np.zeros(nx * ny, dtype=bool)
-        returned[hits[:, 0] * ny + hits[:, 1]] = True
-        flat = flat[~returned[flat]]
+        if self._returned.size != nx * ny:
+            self._returned = np.zeros(nx * ny, dtype=bool)
+        hit_flat = hits[:, 0] * ny + hits[:, 1]
+        self._returned[hit_flat] = True
+        flat = flat[~self._returned[flat]]
+        self._returned[hit_flat] = False  # all False again for the next scan
         seen, occupied = _flat(self.seen), _flat(self.occupied)
         seen[flat] = stamp
         cleared = occupied[flat]
