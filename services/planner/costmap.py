@@ -237,9 +237,18 @@ class Costmap:
         out /= self.resolution
         np.floor(out, out=out)
 
-    def forget_older_than(self, stamp: float) -> None:
-        """Make every cell last seen before ``stamp`` unknown (recovery's clearing)."""
+    def forget_older_than(self, stamp: float, keep: tuple[Vec, float] | None = None) -> None:
+        """Make every cell last seen before ``stamp`` unknown (recovery's clearing),
+        except, with ``keep`` (a point and a radius, m), the cells whose centre lies within
+        the radius of the point (Nav2's clearing except a region round the robot)."""
         old = self.seen < stamp
+        if keep is not None:
+            nx, ny = self.shape
+            i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+            centre, radius = keep
+            x = self.origin[0] + (i + 0.5) * self.resolution
+            y = self.origin[1] + (j + 0.5) * self.resolution
+            old &= np.hypot(x - centre[0], y - centre[1]) > radius
         if (old & self.occupied).any():
             self.version += 1
             self._inflated = None

@@ -824,9 +824,11 @@ class Planner:
 
         if act.step == "replan":
             if self.costmap is not None:
-                # Forget all the map has not seen in the last second: what is in view now
-                # is rebuilt by the next scans, stale marks behind are dropped.
-                self.costmap.forget_older_than(stamp - 1.0)
+                # Forget what the map has not seen in the last second beyond the window:
+                # stale marks far off are dropped. Within the window the map is kept: the
+                # 180-degree laser does not see beside and behind the robot, and a wall
+                # forgotten there would draw the new path through it.
+                self.costmap.forget_older_than(stamp - 1.0, keep=(robot, p.window_radius))
                 self.last_replan = -math.inf
                 self.replan_asked = "recovery"
                 self.update_path(robot, stamp)

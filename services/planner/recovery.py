@@ -7,7 +7,8 @@ does not count, up to ``wait_allowance`` s in a row. The stop zone refusing moti
 ``stop_zone_timeout`` s counts as no progress at once. Either starts recovery, whose
 steps are tried one per failure, in this order:
 
-1. ``replan``: forget what the map has not seen lately and plan the global path again;
+1. ``replan``: forget what the map has not seen lately beyond the window round the
+   robot, and plan the global path again;
 2. ``spin``: turn in place a full turn, so the 180-degree laser sees all round;
 3. ``back_up``: reverse a short distance (only where the robot has just been);
 4. ``wait``: stand still a while, for movers to pass;

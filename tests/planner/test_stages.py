@@ -221,3 +221,26 @@ def test_while_a_way_is_known_recovery_goes_on_and_never_gives_up() -> None:
     p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
     actions = {p.step(POSE, [], round(k * 0.1, 6)).action for k in range(600)}
     assert {"replan", "spin", "wait"} <= actions and "unreachable" not in actions
+
+
+def test_the_replan_step_keeps_a_wall_beside_the_robot_that_the_laser_no_longer_sees() -> None:
+    # A wall across the way with a gap; the robot saw it, then turned its back to it and
+    # stalled. The re-plan of recovery must not forget the wall out of view and draw the
+    # path through it.
+    p = planner(progress_timeout=4.0)
+    wall = [(3.2, -1.0, 3.4, 3.8), (3.2, 4.8, 3.4, 9.0)]
+    t = 0.0
+    for _ in range(15):  # seen for 1.5 s: confirmed
+        p.step(POSE, [], t, scan_of(POSE, boxes=wall))
+        t = round(t + 0.1, 6)
+    away = (2.0, 3.0, math.pi)
+    actions = []
+    while t < 30.0 and "replan" not in actions:
+        actions.append(p.step(away, [], t, scan_of(away, boxes=wall)).action)
+        t = round(t + 0.1, 6)
+    assert "replan" in actions and t > 4.0  # the wall last seen more than 1 s before
+    assert p.path is not None
+    crossing = [a + (b - a) * ((3.3 - a[0]) / (b[0] - a[0]))
+                for a, b in zip(p.path[:-1], p.path[1:], strict=True)
+                if (a[0] - 3.3) * (b[0] - 3.3) < 0]
+    assert len(crossing) == 1 and 3.8 < crossing[0][1] < 4.8  # through the gap
