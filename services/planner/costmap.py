@@ -18,7 +18,13 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   can leave one out);
 - occupied cells are inflated by the robot radius plus a margin with a Euclidean distance
   transform (scipy.ndimage), so a path through the free cells keeps the robot's disc
-  clear of everything the map holds.
+  clear of everything the map holds;
+- apart from the map the path is planned on, a wall memory keeps every confirmed
+  obstacle cell until a beam passes through it (no decay, no recovery clearing):
+  ``cut_off`` asks it whether the walls ever seen close the goal off from the robot.
+  The decaying map alone cannot say so: at 0.1 m/s going round a ring of walls takes
+  longer than ``decay``, so the side seen first is unknown (free) again by the time the
+  last is seen, and a way "opens" there on every round.
 
 The grid covers start and goal with padding at first and grows (by whole blocks) when
 the robot or a return falls outside it, up to ``max_size`` metres a side.
@@ -34,7 +40,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.ndimage import distance_transform_edt
+from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 
@@ -93,6 +99,7 @@ class Costmap:
         self.seen = np.full((nx, ny), -math.inf)  # stamp a cell was last observed
         self.occupied = np.zeros((nx, ny), dtype=bool)  # what it was then
         self.hit_since = np.full((nx, ny), math.inf)  # start of its current occupied spell
+        self.walls = np.zeros((nx, ny), dtype=bool)  # the wall memory (see cut_off)
         self.now = -math.inf
         self.version = 0  # bumped whenever the occupied set may have changed
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
@@ -152,6 +159,7 @@ class Costmap:
         self.seen = np.pad(self.seen, pad, constant_values=-math.inf)
         self.occupied = np.pad(self.occupied, pad, constant_values=False)
         self.hit_since = np.pad(self.hit_since, pad, constant_values=math.inf)
+        self.walls = np.pad(self.walls, pad, constant_values=False)
         self.origin = self.origin - cells_lo * r
         self.version += 1
         self._inflated = None
@@ -219,10 +227,13 @@ class Costmap:
         seen[flat] = stamp
         cleared = occupied[flat]
         occupied[flat] = False
+        _flat(self.walls)[flat] = False  # a beam went through: no wall there now
         newly = ~self.occupied[hits[:, 0], hits[:, 1]]
         self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
         self.seen[hits[:, 0], hits[:, 1]] = stamp
         self.occupied[hits[:, 0], hits[:, 1]] = True
+        confirmed = self.hit_since[hits[:, 0], hits[:, 1]] <= stamp - self.confirm
+        self.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
         if cleared.any() or newly.any() or self.confirm > 0:
             self.version += 1
 
@@ -257,6 +268,31 @@ class Costmap:
         self.hit_since[old] = math.inf
 
     # -- reading -----------------------------------------------------------------------
+
+    def cut_off(self, start: Vec, goal: Vec, clearance: float) -> bool:
+        """Whether the wall memory closes ``goal`` off from ``start``: the goal's cell is
+        a remembered wall, or no way of free cells (every cell centre farther than
+        ``clearance`` from the remembered walls) joins the free cells within
+        ``clearance`` plus a cell of the start to those near the goal. Unknown cells
+        count as free, so this errs toward a way: only walls seen close the goal off."""
+        ends = self.cell_of(np.vstack([start, goal]))
+        if not self.inside(ends).all():
+            return False  # beyond the grid: no knowledge, no verdict
+        if self.walls[ends[1, 0], ends[1, 1]]:
+            return True
+        if not self.walls.any():
+            return False
+        gap = np.asarray(distance_transform_edt(~self.walls), dtype=np.float64)
+        free = gap * self.resolution > clearance
+        labels, _ = label(free)
+        reach = math.ceil(clearance / self.resolution) + 1
+
+        def near(cell: npt.NDArray[np.int64]) -> set[int]:
+            i, j = int(cell[0]), int(cell[1])
+            window = labels[max(i - reach, 0):i + reach + 1, max(j - reach, 0):j + reach + 1]
+            return set(np.unique(window[window > 0]).tolist())
+
+        return not near(ends[0]) & near(ends[1])
 
     def known(self) -> BoolGrid:
         return np.asarray(self.seen >= self.now - self.decay)

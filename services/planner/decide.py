@@ -130,6 +130,8 @@ class Planner:
             spin_angle=params.spin_angle(), backup_distance=params.backup_distance,
             backup_speed=params.backup_speed, wait_time=params.wait_time,
             max_rounds=params.recovery_rounds))
+        self.walled = False  # the goal cut off by the wall memory (``walled_in``)
+        self.walled_stamp = -math.inf
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0
         self.safety_heading: float | None = None  # the safety stage's last heading
@@ -686,9 +688,13 @@ class Planner:
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(decision, pose, scan)
             waiting = decision.action in ("stop", "slow") and decision.kind == "dynamic"
-            if p.recovery and self.recovery.watch(stamp, self.to_go(robot), waiting,
-                                                  decision.refused):
-                way = self.plan is None or self.plan.found
+            # Walled in: the goal is cut off by walls seen (the wall memory), so gains
+            # along a path through forgotten walls are no progress: the steps follow one
+            # another at once instead of after a stall (and progress does not reset them).
+            walled = p.recovery and self.walled_in(robot, stamp)
+            if p.recovery and (walled or self.recovery.watch(
+                    stamp, self.to_go(robot), waiting, decision.refused)):
+                way = (self.plan is None or self.plan.found) and not walled
                 step = self.recovery.start_next(stamp, pose, way_known=way)
                 if step is None:
                     decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
@@ -802,6 +808,18 @@ class Planner:
                         samples[:, None, 1] - trail[None, :, 1]).min(axis=1)
         return bool((gaps <= p.robot_radius / 2).all())
 
+    def walled_in(self, robot: Vec, stamp: float, fresh: bool = False) -> bool:
+        """Whether the wall memory (``Costmap.cut_off``: every obstacle confirmed and no
+        beam through it since, with no decay) closes the goal off from the robot, for a
+        disc of the robot's radius. Looked at again at most every ``replan_period`` s
+        (at once with ``fresh``)."""
+        if self.costmap is None:
+            return False
+        if fresh or stamp - self.walled_stamp >= self.p.replan_period:
+            self.walled_stamp = stamp
+            self.walled = self.costmap.cut_off(robot, self.goal, self.p.robot_radius)
+        return self.walled
+
     def recover(self, pose: tuple[float, float, float], stamp: float,
                 scan: ScanData | None) -> Decision | None:
         """The command of the recovery step under way, or None when none is."""
@@ -809,8 +827,9 @@ class Planner:
         p = self.p
         robot = np.array(pose[:2], dtype=np.float64)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        no_way = self.plan is not None and not self.plan.found
-        if r.active is None and no_way and r.level >= len(STEPS):
+        if r.active is None and r.level >= len(STEPS) and (
+                (self.plan is not None and not self.plan.found)
+                or self.walled_in(robot, stamp, fresh=True)):
             # Every recovery step tried and still no way on the map: give up, clearly.
             r.unreachable = True
             return Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
