@@ -697,6 +697,7 @@ class Planner:
                 way = (self.plan is None or self.plan.found) and not walled
                 step = self.recovery.start_next(stamp, pose, way_known=way)
                 if step is None:
+                    self._walled_off()
                     decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
                 else:
                     self.detour = None
@@ -820,6 +821,13 @@ class Planner:
             self.walled = self.costmap.cut_off(robot, self.goal, self.p.robot_radius)
         return self.walled
 
+    def _walled_off(self) -> None:
+        """The goal is given up on: when the map still shows a way (through walls it has
+        forgotten) but the wall memory closes the goal off, the plan becomes "no way", so
+        the path published is empty, not the one through the forgotten walls."""
+        if self.walled and (self.plan is None or self.plan.found):
+            self.plan = GlobalPlan(np.empty((0, 2)), math.inf, "the walls seen close it off")
+
     def recover(self, pose: tuple[float, float, float], stamp: float,
                 scan: ScanData | None) -> Decision | None:
         """The command of the recovery step under way, or None when none is."""
@@ -832,6 +840,7 @@ class Planner:
                 or self.walled_in(robot, stamp, fresh=True)):
             # Every recovery step tried and still no way on the map: give up, clearly.
             r.unreachable = True
+            self._walled_off()
             return Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
         act = r.active
         if act is None:

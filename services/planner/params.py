@@ -253,7 +253,8 @@ class Params(MissionParams, StopZoneParams):
     wait_time: float = Field(5.0, ge=0, description="recovery wait: stand still, s")
     recovery_rounds: int = Field(
         2, ge=1, description="rounds of the four recovery steps without progress, with no "
-        "way to the goal on the map, before the goal is declared unreachable"
+        "way to the goal on the map (or the goal cut off by the walls seen, when the steps "
+        "run back to back), before the goal is declared unreachable"
     )
 
     def effective_progress_timeout(self) -> float:

@@ -28,9 +28,9 @@ def ring(cx: float, cy: float, half: float, thickness: float = 0.2,
     if gap > 0:
         west = [(cx - h - t, cy - h - t, cx - h, cy - gap / 2),
                 (cx - h - t, cy + gap / 2, cx - h, cy + h + t)]
-    return west + [(cx + h, cy - h - t, cx + h + t, cy + h + t),
-                   (cx - h - t, cy - h - t, cx + h + t, cy - h),
-                   (cx - h - t, cy + h, cx + h + t, cy + h + t)]
+    return [*west, (cx + h, cy - h - t, cx + h + t, cy + h + t),
+            (cx - h - t, cy - h - t, cx + h + t, cy - h),
+            (cx - h - t, cy + h, cx + h + t, cy + h + t)]
 
 
 # Round the ring, one side at a time, each looked at for 2 s, 40 s apart: the whole
@@ -155,7 +155,7 @@ def test_a_goal_in_a_closed_ring_is_declared_unreachable_within_the_bound() -> N
 def test_a_robot_shut_in_a_closed_room_declares_the_goal_outside_unreachable() -> None:
     room = ring(3.0, 3.0, 1.5)  # the robot at its centre, the goal 5 m away outside
     p = Planner(Params.model_validate({"goal": GOAL, "start": (3.0, 3.0)}))
-    t, decisions, _ = drive(p, (3.0, 3.0, 0.0), 0.0, room, limit=200.0)
+    _, decisions, _ = drive(p, (3.0, 3.0, 0.0), 0.0, room, limit=200.0)
     assert decisions[-1].action == "unreachable", [d.action for d in decisions[-5:]]
     assert decisions[-1].v == 0.0 and decisions[-1].omega == 0.0
 
