@@ -270,16 +270,16 @@ class Costmap:
     # -- reading -----------------------------------------------------------------------
 
     def cut_off(self, start: Vec, goal: Vec, clearance: float) -> bool:
-        """Whether the wall memory closes ``goal`` off from ``start``: the goal's cell is
-        a remembered wall, or no way of free cells (every cell centre farther than
-        ``clearance`` from the remembered walls) joins the free cells within
-        ``clearance`` plus a cell of the start to those near the goal. Unknown cells
-        count as free, so this errs toward a way: only walls seen close the goal off."""
+        """Whether the wall memory closes ``goal`` off from ``start``: no way of free
+        cells (every cell centre farther than ``clearance`` from the remembered walls)
+        joins the free cells within ``clearance`` plus a cell of the start to those near
+        the goal. Unknown cells count as free, so this errs toward a way: only walls seen
+        close the goal off. A mark on the goal's own cell is not enough (a mover passing
+        over the goal leaves one until a beam clears it): the map's "goal occupied"
+        answers that, after a stall."""
         ends = self.cell_of(np.vstack([start, goal]))
         if not self.inside(ends).all():
             return False  # beyond the grid: no knowledge, no verdict
-        if self.walls[ends[1, 0], ends[1, 1]]:
-            return True
         if not self.walls.any():
             return False
         gap = np.asarray(distance_transform_edt(~self.walls), dtype=np.float64)

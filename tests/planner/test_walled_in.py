@@ -98,12 +98,23 @@ def test_a_remembered_wall_a_beam_passes_through_is_forgotten() -> None:
     assert not m.cut_off(np.array([5.5, 3.0]), np.array(GOAL), 0.2)
 
 
-def test_a_goal_on_a_remembered_wall_is_cut_off() -> None:
+def test_a_goal_inside_a_box_seen_all_round_is_cut_off() -> None:
     m = costmap()
-    wall = [(8.02, 1.0, 8.5, 5.0)]  # its face in the goal's cell
-    for k in range(20):
-        m.update(scan_of((2.0, 3.0, 0.0), boxes=wall), 0.1 * k)
-    assert m.cut_off(np.array([2.0, 3.0]), np.array(GOAL), 0.2)
+    look_round(m, ring(*GOAL, 0.4, thickness=0.4))  # a solid-looking 1.6 m block: the
+    # goal 0.4 m inside its faces, in cells no beam reaches
+    assert m.cut_off(np.array([8.0, 0.5]), np.array(GOAL), 0.2)
+
+
+def test_a_mover_passing_over_the_goal_never_cuts_it_off() -> None:
+    # A slow disc comes down the line through the goal toward the robot (the paper's
+    # robustness run, Ob4): its front marks the goal's cell for a while.
+    m = costmap()
+    pose = (5.0, 3.0, 0.0)
+    for k in range(300):
+        t = 0.1 * k
+        disc = (10.0 - 0.1 * t, 3.0, 0.2)
+        m.update(scan_of(pose, discs=[disc]), t)
+        assert not m.cut_off(np.array(pose[:2]), np.array(GOAL), 0.2), t
 
 
 # -- the planner: recovery ends in unreachable ----------------------------------------------
