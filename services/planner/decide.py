@@ -296,17 +296,26 @@ class Planner:
 
     def _mapped(self, a: Assessment, stamp: float) -> bool:
         """Whether a standing obstacle has been seen long enough to be in the map, and
-        the map holds it: an occupied cell within its radius of its centre."""
+        the map holds it: an occupied cell within its radius of its centre, or within
+        its cell box S_k, the box the (b) test found on the way. The box counts too
+        because a track of a wall is a stretch of the face the laser sees, and its
+        estimated centre can drift off that face (into a thick wall, or along it), where
+        the map holds nothing; the face itself is in the map and in S_k."""
         seen = stamp - self.first_seen.get(a.obstacle.id, stamp)
         if self.costmap is None or seen < self.p.map_confirm + 0.5:
             return False
         ob = a.obstacle
-        reach = ob.radius + self.p.map_resolution
+        step = self.p.map_resolution
+        reach = ob.radius + step
         ring = np.array([[ob.position[0] + dx, ob.position[1] + dy]
-                         for dx in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
-                         for dy in np.arange(-reach, reach + 1e-9, self.p.map_resolution)
+                         for dx in np.arange(-reach, reach + 1e-9, step)
+                         for dy in np.arange(-reach, reach + 1e-9, step)
                          if dx * dx + dy * dy <= reach * reach])
-        return bool(self.costmap.lethal_at(ring).any())
+        lo, hi = cell_squares(ob.cells, self.p.cell)
+        xs = np.arange(lo[0] + step / 2, hi[0], step)
+        ys = np.arange(lo[1] + step / 2, hi[1], step)
+        box = np.array([[x, y] for x in xs for y in ys], dtype=np.float64).reshape(-1, 2)
+        return bool(self.costmap.lethal_at(np.vstack([ring.reshape(-1, 2), box])).any())
 
     def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
         """Beyond the paper: whether the straight way to ``target`` is free on the map's
@@ -328,7 +337,37 @@ class Planner:
         first = min(self.p.map_resolution, length)
         samples = path_points(robot + direction * first, direction, length - first,
                               self.p.map_resolution / 2)
-        return not bool(self.costmap.blocked_at(samples).any())
+        if not self.costmap.blocked_at(samples).any():
+            return True
+        return to_goal and self._path_passable(robot, target)
+
+    def _path_passable(self, robot: Vec, target: Vec) -> bool:
+        """Whether the way on along the global path is still passable on the map: the
+        straight way to ``target`` (the look-ahead point) and the path from the robot's
+        projection to the window's edge keep the robot's disc off the centre of every
+        occupied cell. The path was planned on this map's inflated grid; what this asks
+        is only that nothing has been mapped on it since. A path through a gap that is
+        narrow for the inflation (a 0.8 m gap leaves one 0.1 m cell column outside it)
+        runs through inflated cells, a cell or two from the faces: that is no reason to
+        leave the path for a detour on the 0.5 m boxes, which close such a gap."""
+        assert self.costmap is not None
+        if self.path is None:
+            return False
+        p = self.p
+        step = p.map_resolution / 2
+        s0 = project(self.path, robot)[0]
+        lengths = arc_lengths(self.path)
+        s = np.arange(s0, min(s0 + p.window_radius, float(lengths[-1])) + step / 2, step)
+        along = np.column_stack([np.interp(s, lengths, self.path[:, 0]),
+                                 np.interp(s, lengths, self.path[:, 1])])
+        offset = target - robot
+        distance = float(np.hypot(*offset))
+        chord = path_points(robot, offset / max(distance, 1e-9), distance, step)
+        points = np.vstack([along, chord])
+        cells = self.costmap.cell_of(points)
+        inside = self.costmap.inside(cells)
+        gap = self.costmap.gap()[cells[inside, 0], cells[inside, 1]]
+        return bool((gap >= p.robot_radius - 1e-6).all())
 
     # -- responses ---------------------------------------------------------------------
 

@@ -5,6 +5,7 @@ The robot starts at (2, 3) heading +x for a goal at (8, 3), at the paper's 0.1 m
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -244,3 +245,34 @@ def test_the_replan_step_keeps_a_wall_beside_the_robot_that_the_laser_no_longer_
                 for a, b in zip(p.path[:-1], p.path[1:], strict=True)
                 if (a[0] - 3.3) * (b[0] - 3.3) < 0]
     assert len(crossing) == 1 and 3.8 < crossing[0][1] < 4.8  # through the gap
+
+
+def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the_gap() -> None:
+    # A wall across the way with a 0.82 m gap left of the line; the global path goes
+    # through it. The tracks of the wall's two stretches by the gap have 0.5 m cell boxes
+    # S_k that close the gap, and small estimated discs inside the wall's thickness,
+    # away along it from the face the map holds (as in unseen-wall-gap-0). Both
+    # stretches are in the map and the path already goes round them: the local layer
+    # follows the path through the gap, with no (b) detour along the wall.
+    p = planner(window_radius=2.0)
+    wall = [(4.95, -1.0, 5.35, 3.9), (4.95, 4.72, 5.35, 9.0)]
+    tracks = [Obstacle(1, "static", (5.3, 2.6), (0.0, 0.0), 0.04, (10, 10, 7, 8)),
+              Obstacle(2, "static", (5.3, 5.9), (0.0, 0.0), 0.04, (10, 10, 9, 10))]
+    x, y, heading = POSE
+    t = 0.0
+    trajectory = [(x, y)]
+    actions = set()
+    while x < 5.8 and t < 90.0:
+        pose = (x, y, heading)
+        d = p.step(pose, tracks, t, scan_of(pose, boxes=wall))
+        actions.add((d.scenario, d.action))
+        heading += d.omega * 0.1
+        x, y = x + d.v * 0.1 * math.cos(heading), y + d.v * 0.1 * math.sin(heading)
+        trajectory.append((x, y))
+        t = round(t + 0.1, 6)
+    assert p.path is not None and len(p.path) > 2  # planned round the wall, on the map
+    assert ("b", "morphin") not in actions and ("h", "morphin") not in actions
+    crossing = [(a, b) for a, b in itertools.pairwise(trajectory)
+                if a[0] < 5.15 <= b[0]]
+    assert len(crossing) == 1 and 3.9 < crossing[0][1][1] < 4.72  # through the gap
+    assert x >= 5.8  # and on past the wall
