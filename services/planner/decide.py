@@ -312,8 +312,9 @@ class Planner:
                          for dy in np.arange(-reach, reach + 1e-9, step)
                          if dx * dx + dy * dy <= reach * reach])
         lo, hi = cell_squares(ob.cells, self.p.cell)
-        xs = np.arange(lo[0] + step / 2, hi[0], step)
-        ys = np.arange(lo[1] + step / 2, hi[1], step)
+        # Edges included: a box may hold only a sliver of the face, along its edge.
+        xs = np.linspace(lo[0], hi[0], math.ceil((hi[0] - lo[0]) / step) + 1)
+        ys = np.linspace(lo[1], hi[1], math.ceil((hi[1] - lo[1]) / step) + 1)
         box = np.array([[x, y] for x in xs for y in ys], dtype=np.float64).reshape(-1, 2)
         return bool(self.costmap.lethal_at(np.vstack([ring.reshape(-1, 2), box])).any())
 
@@ -368,6 +369,29 @@ class Planner:
         inside = self.costmap.inside(cells)
         gap = self.costmap.gap()[cells[inside, 0], cells[inside, 1]]
         return bool((gap >= p.robot_radius - 1e-6).all())
+
+    def _replan_round_mapped(self, robot: Vec, path_target: Vec, threats: list[Assessment],
+                             stamp: float) -> bool:
+        """Beyond the paper: a (b) on an obstacle the map holds, while the global path
+        still runs into what the map holds within the window (it was planned before the
+        map held the obstacle, and the path is planned again for the map alone only
+        when it is blocked beyond the window): plan the path again on the map now,
+        rather than a detour on the 0.5 m boxes, which can close a narrow gap and take
+        the robot along a wall toward its end. At most once per ``replan_period``;
+        whether a path was found."""
+        p = self.p
+        if self.costmap is None or not p.use_map or self.path is None:
+            return False
+        if stamp - self.last_replan < p.replan_period:
+            return False
+        if not any(a.letter == "b" and self._mapped(a, stamp) for a in threats):
+            return False
+        if self._path_passable(robot, path_target):
+            return False
+        count = self.plan_count
+        self.replan_asked = "mapped obstacle on the path"
+        self.update_path(robot, stamp)
+        return self.plan_count != count
 
     # -- responses ---------------------------------------------------------------------
 
@@ -567,6 +591,16 @@ class Planner:
         threats = [self._sticky(a) for a in notes
                    if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
                    and not (a.letter == "b" and clear and self._mapped(a, stamp))]
+        if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
+                                                             stamp):
+            # The path now goes round what the map holds: judge the way along it again.
+            path_target = target = self.path_target(robot, self._statics(in_window))
+            notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
+            clear = self._map_clear(robot, target, to_goal=True)
+            threats = [self._sticky(a) for a in notes
+                       if a.threat and a.obstacle.kind != "new"
+                       and not self._unconfirmed(a, stamp)
+                       and not (a.letter == "b" and clear and self._mapped(a, stamp))]
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
