@@ -247,14 +247,19 @@ def test_the_replan_step_keeps_a_wall_beside_the_robot_that_the_laser_no_longer_
     assert len(crossing) == 1 and 3.8 < crossing[0][1] < 4.8  # through the gap
 
 
-def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the_gap() -> None:
-    # A wall across the way with a 0.82 m gap left of the line; the global path goes
-    # through it. The tracks of the wall's two stretches by the gap have 0.5 m cell boxes
-    # S_k that close the gap, and small estimated discs inside the wall's thickness,
-    # away along it from the face the map holds (as in unseen-wall-gap-0). Both
-    # stretches are in the map and the path already goes round them: the local layer
-    # follows the path through the gap, with no (b) detour along the wall.
-    p = planner(window_radius=2.0)
+@pytest.mark.parametrize("window", [2.0, 4.0])
+def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the_gap(
+    window: float,
+) -> None:
+    # A wall across the way with a 0.82 m gap left of the line. The tracks of the wall's
+    # two stretches by the gap have 0.5 m cell boxes S_k that close the gap, and small
+    # estimated discs inside the wall's thickness, away along it from the face the map
+    # holds (as in unseen-wall-gap-0). Both stretches are in the map. With a 2 m window
+    # the wall is beyond it at first and the path is planned through the gap for the
+    # map; with a 4 m window the wall is inside it from the start, and the path is
+    # planned again when the local layer meets the mapped wall on it. Either way the
+    # local layer follows the path through the gap, with no (b) detour along the wall.
+    p = planner(window_radius=window)
     wall = [(4.95, -1.0, 5.35, 3.9), (4.95, 4.72, 5.35, 9.0)]
     tracks = [Obstacle(1, "static", (5.3, 2.6), (0.0, 0.0), 0.04, (10, 10, 7, 8)),
               Obstacle(2, "static", (5.3, 5.9), (0.0, 0.0), 0.04, (10, 10, 9, 10))]
