@@ -361,32 +361,47 @@ class Planner:
         s = np.arange(s0, min(s0 + p.window_radius, float(lengths[-1])) + step / 2, step)
         along = np.column_stack([np.interp(s, lengths, self.path[:, 0]),
                                  np.interp(s, lengths, self.path[:, 1])])
-        offset = target - robot
+        return self._disc_clear(np.vstack([along, self._leg(robot, target)]))
+
+    def _leg(self, robot: Vec, end: Vec) -> Vec:
+        """Points every half map cell on the straight way from ``robot`` to ``end``."""
+        offset = end - robot
         distance = float(np.hypot(*offset))
-        chord = path_points(robot, offset / max(distance, 1e-9), distance, step)
-        points = np.vstack([along, chord])
+        return path_points(robot, offset / max(distance, 1e-9), distance,
+                           self.p.map_resolution / 2)
+
+    def _disc_clear(self, points: Vec) -> bool:
+        """Whether the robot's disc, centred on each of ``points``, covers no occupied
+        cell's centre of the map."""
+        assert self.costmap is not None
         cells = self.costmap.cell_of(points)
         inside = self.costmap.inside(cells)
         gap = self.costmap.gap()[cells[inside, 0], cells[inside, 1]]
-        return bool((gap >= p.robot_radius - 1e-6).all())
+        return bool((gap >= self.p.robot_radius - 1e-6).all())
 
     def _replan_round_mapped(self, robot: Vec, path_target: Vec, threats: list[Assessment],
-                             stamp: float) -> bool:
+                             obstacles: list[Obstacle], stamp: float) -> bool:
         """Beyond the paper: a (b) on an obstacle the map holds, while the global path
         still runs into what the map holds within the window (it was planned before the
         map held the obstacle, and the path is planned again for the map alone only
         when it is blocked beyond the window): plan the path again on the map now,
-        rather than a detour on the 0.5 m boxes, which can close a narrow gap and take
-        the robot along a wall toward its end. At most once per ``replan_period``;
-        whether a path was found."""
+        rather than a detour on the 0.5 m boxes, when the paper's detour would take the
+        robot into what the map holds (the boxes can close a narrow gap and send the
+        robot along a wall toward its end). A detour the map agrees with is kept, as in
+        the paper. At most once per ``replan_period``; whether a path was found."""
         p = self.p
         if self.costmap is None or not p.use_map or self.path is None:
             return False
         if stamp - self.last_replan < p.replan_period:
             return False
-        if not any(a.letter == "b" and self._mapped(a, stamp) for a in threats):
+        mapped = [a for a in threats if a.letter == "b" and self._mapped(a, stamp)]
+        if not mapped or self._path_passable(robot, path_target):
             return False
-        if self._path_passable(robot, path_target):
+        sides = dict(self.sides)  # a trial: the side it picks is not kept
+        trial = self.plan_detour(robot, min(mapped, key=lambda a: a.robot_distance),
+                                 obstacles, fast=False)
+        self.sides = sides
+        if trial is not None and self._disc_clear(self._leg(robot, trial.subtarget)):
             return False
         count = self.plan_count
         self.replan_asked = "mapped obstacle on the path"
@@ -592,7 +607,7 @@ class Planner:
                    if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
                    and not (a.letter == "b" and clear and self._mapped(a, stamp))]
         if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
-                                                             stamp):
+                                                             in_window, stamp):
             # The path now goes round what the map holds: judge the way along it again.
             path_target = target = self.path_target(robot, self._statics(in_window))
             notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
