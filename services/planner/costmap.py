@@ -36,12 +36,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt, label
 
+from zenav.services.compiled import kernel
 from zenav.services.perception.clustering import to_global
 
 Vec = npt.NDArray[np.float64]
@@ -63,7 +64,10 @@ class ScanData:
     range_min: float = 0.0
 
 
-def _flat(grid: npt.NDArray[np.generic]) -> npt.NDArray[np.generic]:
+G = TypeVar("G", bound=np.generic)
+
+
+def _flat(grid: npt.NDArray[G]) -> npt.NDArray[G]:
     """A flat view of a grid (never a copy: the grids are C-contiguous)."""
     flat = grid.reshape(-1)
     assert flat.base is grid or flat.base is grid.base
@@ -101,7 +105,8 @@ class Costmap:
         self.hit_since = np.full((nx, ny), math.inf)  # start of its current occupied spell
         self.walls = np.zeros((nx, ny), dtype=bool)  # the wall memory (see cut_off)
         self.now = -math.inf
-        self.version = 0  # bumped whenever the occupied set may have changed
+        self.version = 0  # bumped whenever the grids change
+        self._refreshed: tuple[int, float] | None = None  # (version, now) of the cache
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None
         self._scratch = np.empty(0)  # reused by the ray tracing
@@ -180,30 +185,6 @@ class Costmap:
         ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
         self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
                      self.padding / 2)
-        # Free space: every half cell along each beam, stopping half a cell short of
-        # its return (a beam with no return clears up to its reach). Only the set of
-        # cells matters, so they are found as flat indices, computed per axis with the
-        # same arithmetic as ``cell_of`` (bit for bit the same cells).
-        step = self.resolution / 2
-        reach = np.where(hit, ranges - step, ranges)
-        count = math.ceil(float(reach.max(initial=0.0)) / step) + 1
-        s = np.arange(count) * step  # (k,)
-        along = s[None, :] <= reach[:, None]  # (beams, k)
-        nx, ny = self.shape
-        shape = along.shape
-        if self._scratch.size < 2 * along.size:
-            self._scratch = np.empty(2 * along.size)
-        fx = self._scratch[:along.size].reshape(shape)
-        fy = self._scratch[along.size:2 * along.size].reshape(shape)
-        self._axis_cells(fx, x, s, ux, 0)
-        self._axis_cells(fy, y, s, uy, 1)
-        along &= fx >= 0
-        along &= fx < nx
-        along &= fy >= 0
-        along &= fy < ny
-        fx *= ny
-        fx += fy  # the flat index, exact: whole numbers far below 2**53
-        flat = fx[along].astype(np.intp)
         # Hits, except those on a mover.
         marks = ends[hit]
         if movers and len(marks):
@@ -213,40 +194,32 @@ class Costmap:
             marks = marks[(gap > self.resolution).all(axis=1)]
         hits = self.cell_of(marks)
         hits = hits[self.inside(hits)]
+        nx, ny = self.shape
+        # Free space: every half cell along each beam, stopping half a cell short of
+        # its return (a beam with no return clears up to its reach); see _clear_beams.
         # A cell a return of this scan falls in is not cleared by this scan: along a
         # straight wall, the beams that meet it at a grazing angle pass through the face
         # cells the others return from, and clearing them would restart their
         # confirmation on every scan (a wall seen side-on would never be confirmed).
+        step = self.resolution / 2
+        # (never beyond the laser's reach: a range above it must not make a beam endless)
+        reach = np.minimum(np.where(hit, ranges - step, ranges), scan.range_max)
         if self._returned.size != nx * ny:
             self._returned = np.zeros(nx * ny, dtype=bool)
         hit_flat = hits[:, 0] * ny + hits[:, 1]
         self._returned[hit_flat] = True
-        flat = flat[~self._returned[flat]]
+        _clear_beams(x, y, np.ascontiguousarray(ux), np.ascontiguousarray(uy), reach, step,
+                     float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
+                     self._returned, stamp, _flat(self.seen),
+                       _flat(self.occupied), _flat(self.walls))
         self._returned[hit_flat] = False  # all False again for the next scan
-        seen, occupied = _flat(self.seen), _flat(self.occupied)
-        seen[flat] = stamp
-        cleared = occupied[flat]
-        occupied[flat] = False
-        _flat(self.walls)[flat] = False  # a beam went through: no wall there now
         newly = ~self.occupied[hits[:, 0], hits[:, 1]]
         self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
         self.seen[hits[:, 0], hits[:, 1]] = stamp
         self.occupied[hits[:, 0], hits[:, 1]] = True
         confirmed = self.hit_since[hits[:, 0], hits[:, 1]] <= stamp - self.confirm
         self.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
-        if cleared.any() or newly.any() or self.confirm > 0:
-            self.version += 1
-
-    def _axis_cells(self, out: Vec, x: float, s: npt.NDArray[np.floating[Any]], unit: Vec,
-                    axis: int) -> None:
-        """The cell index along ``axis``, as a whole float, of every sample
-        ``x + s * unit`` of every beam (``unit``: the beams' direction components; the
-        arithmetic of :meth:`cell_of`, in place)."""
-        np.multiply.outer(unit, s, out=out)
-        out += x
-        out -= self.origin[axis]
-        out /= self.resolution
-        np.floor(out, out=out)
+        self.version += 1
 
     def forget_older_than(self, stamp: float, keep: tuple[Vec, float] | None = None) -> None:
         """Make every cell last seen before ``stamp`` unknown (recovery's clearing),
@@ -261,8 +234,8 @@ class Costmap:
             y = self.origin[1] + (j + 0.5) * self.resolution
             old &= np.hypot(x - centre[0], y - centre[1]) > radius
         if (old & self.occupied).any():
-            self.version += 1
             self._inflated = None
+        self.version += 1
         self.seen[old] = -math.inf
         self.occupied[old] = False
         self.hit_since[old] = math.inf
@@ -304,6 +277,11 @@ class Costmap:
                           & (self.hit_since <= self.now - self.confirm))
 
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
+        # Lethal cells change only with the grids and the time (decay, confirmation):
+        # a cycle asks several times with neither changed.
+        if self._inflated is not None and self._refreshed == (self.version, self.now):
+            return self._inflated
+        self._refreshed = (self.version, self.now)
         lethal = self.lethal()
         # The inflation depends on the lethal set alone: compare the set itself (decay
         # and confirmation change it without an update, and an update with confirmation
@@ -362,3 +340,30 @@ class Costmap:
         out[known] = FREE
         out[self.lethal()] = OCCUPIED
         return out
+
+
+@kernel
+def _clear_beams(x: float, y: float, ux: Vec, uy: Vec, reach: Vec, step: float, ox: float,
+                 oy: float, resolution: float, ny: int, returned: npt.NDArray[np.bool_],
+                 stamp: float, seen: Vec, occupied: npt.NDArray[np.bool_],
+                 walls: npt.NDArray[np.bool_]) -> None:
+    """Mark free, seen at ``stamp``, every cell of the flat grids (``ny`` cells a column)
+    that a point ``s = 0, step, 2 step, ...`` m along a beam from (x, y) falls in, up to
+    the beam's ``reach`` (direction ``(ux, uy)``), except the cells ``returned`` flags.
+    A cell is found with the arithmetic of :meth:`Costmap.cell_of`."""
+    nx = seen.shape[0] // ny
+    for b in range(ux.shape[0]):
+        k = 0
+        while k * step <= reach[b]:
+            s = k * step
+            k += 1
+            ix = math.floor((ux[b] * s + x - ox) / resolution)
+            iy = math.floor((uy[b] * s + y - oy) / resolution)
+            if ix < 0 or ix >= nx or iy < 0 or iy >= ny:
+                continue
+            cell = ix * ny + iy
+            if returned[cell]:
+                continue
+            seen[cell] = stamp
+            occupied[cell] = False
+            walls[cell] = False

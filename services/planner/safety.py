@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.compiled import kernel
 from zenav.services.geometry import wrap_angle, wrap_angles
 
 Vec = npt.NDArray[np.float64]
@@ -98,24 +99,38 @@ class Choice:
 def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, Vec]:
     """Positions (n, k) of the robot driving toward each heading at each speed, at
     ``times`` (k,), evenly spaced from one step on."""
-    dt = float(times[0])
-    n = headings.shape[0]
-    xs = np.empty((n, times.shape[0]))
-    ys = np.empty_like(xs)
-    x = np.full(n, robot.x)
-    y = np.full(n, robot.y)
-    theta = np.full(n, robot.heading)
-    v = np.full(n, robot.speed)
-    for k in range(times.shape[0]):
-        error = wrap_angles(headings - theta)
-        omega = np.clip(robot.heading_gain * error, -robot.max_omega, robot.max_omega)
-        wanted = speeds * np.maximum(np.cos(error), 0.0)
-        v = np.clip(wanted, v - robot.decel * dt, v + robot.accel * dt)
-        theta = theta + omega * dt
-        x = x + v * np.cos(theta) * dt
-        y = y + v * np.sin(theta) * dt
-        xs[:, k], ys[:, k] = x, y
+    n, k = headings.shape[0], times.shape[0]
+    xs = np.empty((n, k))
+    ys = np.empty((n, k))
+    _drive(np.ascontiguousarray(headings, dtype=np.float64),
+           np.ascontiguousarray(speeds, dtype=np.float64), float(times[0]), robot.x, robot.y,
+           robot.heading, robot.speed, robot.heading_gain, robot.max_omega, robot.accel,
+           robot.decel, xs, ys)
     return xs, ys
+
+
+@kernel
+def _drive(headings: Vec, speeds: Vec, dt: float, x0: float, y0: float, theta0: float,
+           v0: float, gain: float, max_omega: float, accel: float, decel: float, xs: Vec,
+           ys: Vec) -> None:
+    """The unicycle of :func:`rollout`, candidate by candidate, step by step, into
+    ``xs`` and ``ys`` (n, k): the heading error wrapped as :func:`wrap_angles` does,
+    the turn rate and the speed clipped to their limits."""
+    two_pi = 2.0 * math.pi
+    for i in range(headings.shape[0]):
+        x, y, theta, v = x0, y0, theta0, v0
+        for k in range(xs.shape[1]):
+            error = (headings[i] - theta + math.pi) % two_pi - math.pi
+            if error <= -math.pi:
+                error += two_pi
+            omega = min(max(gain * error, -max_omega), max_omega)
+            wanted = speeds[i] * max(math.cos(error), 0.0)
+            v = min(max(wanted, v - decel * dt), v + accel * dt)
+            theta = theta + omega * dt
+            x = x + v * math.cos(theta) * dt
+            y = y + v * math.sin(theta) * dt
+            xs[i, k] = x
+            ys[i, k] = y
 
 
 def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,
@@ -152,22 +167,19 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     the point on the global path progress is measured to; ``blocked``: which points the
     map holds (None: no map)."""
     heading, speed = proposal
+    steps = max(round(s.horizon / s.step), 1)
+    times = s.step * np.arange(1, steps + 1, dtype=np.float64)
+    # The proposal alone first: most cycles keep it, and the fan's roll-outs (the same
+    # numbers for the proposal, row by row) are needed only when it is not safe.
+    _, _, cost, first_t, _ = _score(robot, np.array([heading]), np.array([speed]), times,
+                                    movers, blocked, s)
+    if math.isinf(first_t[0]) and cost[0] < 10.0:
+        return Choice(heading, speed, True, math.inf, None)
     fan = np.arange(-math.pi, math.pi, s.fan_step)
     headings = np.concatenate(([heading], np.repeat(heading + fan, len(s.speeds))))
     speeds = np.concatenate(([speed], np.tile(np.asarray(s.speeds) * robot.max_speed,
                                               fan.shape[0])))
-    steps = max(round(s.horizon / s.step), 1)
-    times = s.step * np.arange(1, steps + 1, dtype=np.float64)
-    xs, ys = rollout(robot, headings, speeds, times)
-    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
-    if blocked is not None:
-        walls = blocked(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
-        start_blocked = bool(blocked(np.array([[robot.x, robot.y]]))[0])
-        if not start_blocked:  # inside the inflation already: the map cannot judge
-            hit = walls.any(axis=1)
-            cost = cost + np.where(hit, 10.0, 0.0)
-    if math.isinf(first_t[0]) and cost[0] < 10.0:
-        return Choice(heading, speed, True, math.inf, None)
+    xs, ys, cost, first_t, who = _score(robot, headings, speeds, times, movers, blocked, s)
     reach = np.hypot(xs[:, -1] - carrot[0], ys[:, -1] - carrot[1])
     total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
     if last_heading is not None:
@@ -176,3 +188,19 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     culprit = int(who[0]) if who[0] >= 0 else None
     return Choice(wrap_angle(float(headings[best])), float(speeds[best]),
                   best == 0, float(first_t[best]), culprit)
+
+
+def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
+           blocked: Callable[[Vec], npt.NDArray[np.bool_]] | None, s: Settings
+           ) -> tuple[Vec, Vec, Vec, Vec, npt.NDArray[np.int64]]:
+    """Roll out each candidate and score its passes by the movers and the map: the
+    positions (n, k), the cost, the time of the first contact and its mover."""
+    xs, ys = rollout(robot, headings, speeds, times)
+    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
+    if blocked is not None:
+        walls = blocked(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
+        start_blocked = bool(blocked(np.array([[robot.x, robot.y]]))[0])
+        if not start_blocked:  # inside the inflation already: the map cannot judge
+            hit = walls.any(axis=1)
+            cost = cost + np.where(hit, 10.0, 0.0)
+    return xs, ys, cost, first_t, who
