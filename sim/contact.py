@@ -86,7 +86,11 @@ def first_contact(
         appear=world.disc_appear,
         vanish=world.disc_vanish,
     )
-    s = circle_entry_time((q[:, 0], q[:, 1]), (v[:, 0], v[:, 1]), world.disc_radii + radius)
+    reach = world.disc_radii + radius
+    near = _within_reach(q, v, span, reach)
+    s = np.full(len(q), np.inf)
+    s[near] = circle_entry_time((q[near, 0], q[near, 1]), (v[near, 0], v[near, 1]),
+                                reach[near])
     times.append(_contact_times(start, span, s, world.disc_vanish))
     ids.append(world.disc_ids)
 
@@ -100,7 +104,10 @@ def first_contact(
         appear=world.box_appear,
         vanish=world.box_vanish,
     )
-    s = _rounded_box_entry_time(q, v, world.box_half_sizes, radius)
+    half = world.box_half_sizes
+    near = _within_reach(q, v, span, np.hypot(half[:, 0], half[:, 1]) + radius)
+    s = np.full(len(q), np.inf)
+    s[near] = _rounded_box_entry_time(q[near], v[near], half[near], radius)
     times.append(_contact_times(start, span, s, world.box_vanish))
     ids.append(world.box_ids)
 
@@ -134,6 +141,17 @@ def _relative_motion(
     robot = robot_p0 + robot_v * (start - t0)[:, None]
     obstacle = centers + velocities * (start - appear)[:, None]
     return start, span, robot - obstacle, robot_v - velocities
+
+
+def _within_reach(q: FloatArray, v: FloatArray, span: FloatArray, reach: FloatArray
+                  ) -> NDArray[np.bool_]:
+    """Which obstacles may come within ``reach`` (m, of their centre) of the robot in
+    their part of the interval: the relative position ``q`` moves at most ``|v| span``.
+    A broad phase: the others cannot touch, so their exact entry times need not be
+    found (they would fall beyond ``span``)."""
+    with np.errstate(invalid="ignore"):  # span -inf: the obstacle does not exist then
+        closest = np.hypot(q[:, 0], q[:, 1]) - np.hypot(v[:, 0], v[:, 1]) * span
+    return np.asarray((span >= 0.0) & (closest <= reach + 1e-9))
 
 
 def _contact_times(
