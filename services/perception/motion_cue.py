@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from zenav.services.geometry import wrap_angles
+from zenav.services.perception import _loops
 from zenav.services.perception.clustering import to_global
 
 FloatArray = npt.NDArray[np.float64]
@@ -55,17 +55,14 @@ class ScanSnapshot:
 
 def seen_free(scan: ScanSnapshot, points: FloatArray, margin: float) -> npt.NDArray[np.bool_]:
     """Whether ``scan`` saw each global point (k, 2) as empty space: the beams toward it
-    (and both neighbours) reached more than ``margin`` beyond it."""
+    (and both neighbours) reached more than ``margin`` beyond it (compiled:
+    ``_loops.seen_free``)."""
     x, y, heading = scan.pose
-    dx, dy = points[:, 0] - x, points[:, 1] - y
-    distance = np.hypot(dx, dy)
-    bearing = wrap_angles(np.arctan2(dy, dx) - heading)
-    beam = np.rint((bearing - scan.angle_min) / scan.angle_increment).astype(np.int64)
-    n = scan.ranges.shape[0]
-    inside = (beam >= 1) & (beam <= n - 2)
-    b = np.clip(beam, 1, n - 2)
-    reach = np.minimum(np.minimum(scan.ranges[b - 1], scan.ranges[b]), scan.ranges[b + 1])
-    return np.asarray(inside & (reach > distance + margin))
+    out = np.empty(points.shape[0], dtype=np.bool_)
+    _loops.seen_free(np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2), x, y,
+                     heading, np.ascontiguousarray(scan.ranges, dtype=np.float64),
+                     scan.angle_min, scan.angle_increment, margin, out.view(np.uint8))
+    return out
 
 
 @dataclass(frozen=True)

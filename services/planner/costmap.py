@@ -42,8 +42,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt, label
 
-from zenav.services.compiled import kernel
 from zenav.services.perception.clustering import to_global
+from zenav.services.planner._loops import clear_beams
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -196,7 +196,8 @@ class Costmap:
         hits = hits[self.inside(hits)]
         nx, ny = self.shape
         # Free space: every half cell along each beam, stopping half a cell short of
-        # its return (a beam with no return clears up to its reach); see _clear_beams.
+        # its return (a beam with no return clears up to its reach), in compiled code
+        # (``_loops.clear_beams``).
         # A cell a return of this scan falls in is not cleared by this scan: along a
         # straight wall, the beams that meet it at a grazing angle pass through the face
         # cells the others return from, and clearing them would restart their
@@ -208,10 +209,10 @@ class Costmap:
             self._returned = np.zeros(nx * ny, dtype=bool)
         hit_flat = hits[:, 0] * ny + hits[:, 1]
         self._returned[hit_flat] = True
-        _clear_beams(x, y, np.ascontiguousarray(ux), np.ascontiguousarray(uy), reach, step,
-                     float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
-                     self._returned, stamp, _flat(self.seen),
-                       _flat(self.occupied), _flat(self.walls))
+        clear_beams(x, y, np.ascontiguousarray(ux), np.ascontiguousarray(uy), reach, step,
+                    float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
+                    self._returned.view(np.uint8), stamp, _flat(self.seen),
+                    _flat(self.occupied).view(np.uint8), _flat(self.walls).view(np.uint8))
         self._returned[hit_flat] = False  # all False again for the next scan
         newly = ~self.occupied[hits[:, 0], hits[:, 1]]
         self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
@@ -340,30 +341,3 @@ class Costmap:
         out[known] = FREE
         out[self.lethal()] = OCCUPIED
         return out
-
-
-@kernel
-def _clear_beams(x: float, y: float, ux: Vec, uy: Vec, reach: Vec, step: float, ox: float,
-                 oy: float, resolution: float, ny: int, returned: npt.NDArray[np.bool_],
-                 stamp: float, seen: Vec, occupied: npt.NDArray[np.bool_],
-                 walls: npt.NDArray[np.bool_]) -> None:
-    """Mark free, seen at ``stamp``, every cell of the flat grids (``ny`` cells a column)
-    that a point ``s = 0, step, 2 step, ...`` m along a beam from (x, y) falls in, up to
-    the beam's ``reach`` (direction ``(ux, uy)``), except the cells ``returned`` flags.
-    A cell is found with the arithmetic of :meth:`Costmap.cell_of`."""
-    nx = seen.shape[0] // ny
-    for b in range(ux.shape[0]):
-        k = 0
-        while k * step <= reach[b]:
-            s = k * step
-            k += 1
-            ix = math.floor((ux[b] * s + x - ox) / resolution)
-            iy = math.floor((uy[b] * s + y - oy) / resolution)
-            if ix < 0 or ix >= nx or iy < 0 or iy >= ny:
-                continue
-            cell = ix * ny + iy
-            if returned[cell]:
-                continue
-            seen[cell] = stamp
-            occupied[cell] = False
-            walls[cell] = False

@@ -38,8 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from zenav.services.compiled import kernel
 from zenav.services.geometry import wrap_angle, wrap_angles
+from zenav.services.planner._loops import drive
 
 Vec = npt.NDArray[np.float64]
 
@@ -102,35 +102,11 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
     n, k = headings.shape[0], times.shape[0]
     xs = np.empty((n, k))
     ys = np.empty((n, k))
-    _drive(np.ascontiguousarray(headings, dtype=np.float64),
-           np.ascontiguousarray(speeds, dtype=np.float64), float(times[0]), robot.x, robot.y,
-           robot.heading, robot.speed, robot.heading_gain, robot.max_omega, robot.accel,
-           robot.decel, xs, ys)
+    drive(np.ascontiguousarray(headings, dtype=np.float64),
+          np.ascontiguousarray(speeds, dtype=np.float64), float(times[0]), robot.x, robot.y,
+          robot.heading, robot.speed, robot.heading_gain, robot.max_omega, robot.accel,
+          robot.decel, xs, ys)
     return xs, ys
-
-
-@kernel
-def _drive(headings: Vec, speeds: Vec, dt: float, x0: float, y0: float, theta0: float,
-           v0: float, gain: float, max_omega: float, accel: float, decel: float, xs: Vec,
-           ys: Vec) -> None:
-    """The unicycle of :func:`rollout`, candidate by candidate, step by step, into
-    ``xs`` and ``ys`` (n, k): the heading error wrapped as :func:`wrap_angles` does,
-    the turn rate and the speed clipped to their limits."""
-    two_pi = 2.0 * math.pi
-    for i in range(headings.shape[0]):
-        x, y, theta, v = x0, y0, theta0, v0
-        for k in range(xs.shape[1]):
-            error = (headings[i] - theta + math.pi) % two_pi - math.pi
-            if error <= -math.pi:
-                error += two_pi
-            omega = min(max(gain * error, -max_omega), max_omega)
-            wanted = speeds[i] * max(math.cos(error), 0.0)
-            v = min(max(wanted, v - decel * dt), v + accel * dt)
-            theta = theta + omega * dt
-            x = x + v * math.cos(theta) * dt
-            y = y + v * math.sin(theta) * dt
-            xs[i, k] = x
-            ys[i, k] = y
 
 
 def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,

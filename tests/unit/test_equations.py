@@ -117,13 +117,20 @@ def test_the_motion_cue_points_are_eq1() -> None:
         np.array([[3.0, 2.0], [4.999391, 2.069810]]), abs=1e-6)
 
 
-def test_the_motion_cue_wraps_with_geometry(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The bearing of each earlier point is wrapped by the one wrap (geometry.py)."""
-    spy = Spy(monkeypatch, motion_cue, "wrap_angles")
-    perceiver = Perceiver(PAPER)
-    perceive([2.0, 2.0, 2.0], perceiver=perceiver)
-    perceive([2.0, 2.0, 2.0], stamp=1.0, perceiver=perceiver)
-    assert spy.calls >= 1
+def test_the_compiled_loops_wrap_as_geometry_does() -> None:
+    """The motion cue's bearings and the safety roll-out's heading errors are wrapped in
+    compiled code (``services/_angles.pxi``); that wrap gives what geometry.py's does,
+    to the bit, at the edges of the range and far beyond it."""
+    from zenav.services import _angles
+    from zenav.services.geometry import wrap_angles
+
+    edges = np.array([0.0, -0.0, math.pi, -math.pi, 2 * math.pi, -2 * math.pi,
+                      3 * math.pi, -3 * math.pi, np.nextafter(math.pi, 4.0),
+                      np.nextafter(-math.pi, -4.0), 1e-17, -1e-17, 1e6, -1e6, 123.456])
+    angles = np.concatenate([edges, np.random.default_rng(0).uniform(-50.0, 50.0, 1000)])
+    wrapped = _angles.wrap_angles(angles)
+    assert np.array_equal(wrapped, wrap_angles(angles))
+    assert ((wrapped > -math.pi) & (wrapped <= math.pi)).all()
 
 
 def test_eq1_is_what_the_map_calls(monkeypatch: pytest.MonkeyPatch) -> None:
