@@ -42,13 +42,21 @@ def world(family: str, seed: int) -> Scenario:
     return random_scenario(family, seed)
 
 
-def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path) -> list[Path]:
+def write_worlds(families: Sequence[str], count: int, seed: int, directory: Path,
+                 fov_deg: float | None = None) -> list[Path]:
+    """The scenario files; ``fov_deg``: every world's laser field of view instead of its
+    own (the paper's 180° unless a family says otherwise)."""
     directory.mkdir(parents=True, exist_ok=True)
     paths = []
     for family in families:
         for s in range(seed, seed + count):
             path = directory / f"{family}-{s}.yaml"
-            paths.append(dump_scenario(world(family, s), path))
+            scene = world(family, s)
+            if fov_deg is not None:
+                data = scene.model_dump(mode="json", exclude_none=True)
+                data["laser"]["fov_deg"] = fov_deg
+                scene = Scenario.model_validate(data)
+            paths.append(dump_scenario(scene, path))
     return paths
 
 
@@ -205,7 +213,8 @@ def verified_note(batch: Records) -> str:
 def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             families: Sequence[str] = FAMILIES, jobs: int = 2,
             progress: bool = True, echo: Callable[[str], None] = print,
-            engine: str = "inprocess", verify: int = DEFAULT_VERIFY) -> str:
+            engine: str = "inprocess", verify: int = DEFAULT_VERIFY,
+            fov_deg: float | None = None) -> str:
     """Write the worlds, run every planner on each, print and write the report."""
     from rich.progress import (
         BarColumn,
@@ -227,8 +236,10 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     if bad:
         raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(KNOWN)} "
                          "or unseen (all the unseen-* classes)")
+    if fov_deg is not None and not (0 < fov_deg <= 360 and (2 * fov_deg).is_integer()):
+        raise ValueError(f"--fov must be in (0, 360] in half degrees (got {fov_deg:g})")
     out.mkdir(parents=True, exist_ok=True)
-    paths = write_worlds(families, worlds, seed, out / "worlds")
+    paths = write_worlds(families, worlds, seed, out / "worlds", fov_deg)
     job_list = [Job(f"{p}/{w.stem}", w, out / "runs" / p / w.stem, planner=p)
                 for w in paths for p in planners]
     records: list[dict[str, Any]] = []
@@ -252,10 +263,12 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     summaries, per_family = summarise(records, planners)
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
-                                   f" --families {','.join(families)}"))
+                                   f" --families {','.join(families)}")
+               + ("" if fov_deg is None else f" --fov {fov_deg:g}"))
     report = (f"# zenav bench nav\n\n`{command}`\n\n"
               f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
-              f"{len(paths)} worlds ({worlds} per family: {', '.join(families)}), "
+              f"{len(paths)} worlds ({worlds} per family: {', '.join(families)}"
+              f"{'' if fov_deg is None else f'; laser {fov_deg:g}°'}), "
               f"{jobs} runs at a time ({engine} engine{verified_note(batch)})\n\n"
               f"{tables(summaries, per_family)}\n\n"
               f"{goal_lines(summaries, per_family)}\n")
@@ -272,7 +285,8 @@ def _command(args: argparse.Namespace) -> int:
     try:
         run_nav(words(args.planners), args.worlds, args.seed, args.out,
                 families=words(args.families), jobs=args.jobs,
-                progress=not args.no_progress, engine=args.engine, verify=args.verify)
+                progress=not args.no_progress, engine=args.engine, verify=args.verify,
+                fov_deg=args.fov)
     except ValueError as exc:
         print(f"zenav bench nav: {exc}", file=sys.stderr)
         return 2
@@ -299,5 +313,9 @@ def add_command(kinds: Any) -> None:
                      f"tick (default {DEFAULT_VERIFY})")
     nav.add_argument("--out", type=Path, default=Path("out/bench-nav"),
                      help="directory for the worlds, runs, nav.md, nav.png, nav.json")
+    nav.add_argument("--fov", type=float, default=None,
+                     help="every world's laser field of view, degrees (default: each "
+                     "world's own, the paper's 180; 360 shows what the 180° laser "
+                     "cannot see)")
     nav.add_argument("--no-progress", action="store_true", help="no progress bar")
     nav.set_defaults(func=_command)
