@@ -30,3 +30,20 @@ def seen_free(const double[:, ::1] points, double x, double y, double heading,
         b = <Py_ssize_t>beam
         reach = min(ranges[b - 1], ranges[b], ranges[b + 1])
         out[i] = reach > distance + margin
+
+
+def count_in_boxes(const double[:, ::1] points, const unsigned char[::1] flags,
+                   const double[:, ::1] lo, const double[:, ::1] hi, long[::1] inside,
+                   long[::1] flagged):
+    """For each box (closed, ``lo`` to ``hi``), how many of the points lie in it
+    (``inside``) and how many of those are flagged (``flagged``), both added to."""
+    cdef Py_ssize_t i, c
+    cdef double px, py
+    for i in range(points.shape[0]):
+        px = points[i, 0]
+        py = points[i, 1]
+        for c in range(lo.shape[0]):
+            if lo[c, 0] <= px <= hi[c, 0] and lo[c, 1] <= py <= hi[c, 1]:
+                inside[c] += 1
+                if flags[i]:
+                    flagged[c] += 1

@@ -121,13 +121,13 @@ def scores_against(clustered: ClusterPoints, current: ScanSnapshot, past: ScanSn
     scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
     if len(past_points) >= 2:
         vacated = seen_free(current, past_points, margin)
-        lo, hi = clustered.lo, clustered.hi
-        px, py = past_points[:, 0, None], past_points[:, 1, None]
-        near = (px >= lo[None, :, 0]) & (px <= hi[None, :, 0])
-        near &= py >= lo[None, :, 1]
-        near &= py <= hi[None, :, 1]  # (past points, clusters): inside each widened box
-        n_near = near.sum(axis=0)
-        gone = (near & vacated[:, None]).sum(axis=0)
+        # The earlier points inside each cluster's widened box, and how many of them the
+        # current scan sees through (compiled: one pass over points and boxes).
+        n_near = np.zeros(n, dtype=np.int64)
+        gone = np.zeros(n, dtype=np.int64)
+        _loops.count_in_boxes(np.ascontiguousarray(past_points, dtype=np.float64),
+                              vacated.view(np.uint8), clustered.lo, clustered.hi, n_near,
+                              gone)
         share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
         scores = np.maximum(scores, share)
     return scores
