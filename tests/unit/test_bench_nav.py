@@ -1,0 +1,68 @@
+"""``zenav bench nav``: ``--fov`` gives the same worlds another laser and nothing else;
+a run that ends standing still while a way existed is counted against the planner, and
+the goal line names every family short of the target."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from zenav.bench.nav import goal_lines, still_at_end, summarise, write_worlds
+from zenav.sim.scenario import load_scenario
+
+
+def test_fov_changes_only_the_laser(tmp_path: Path) -> None:
+    own = write_worlds(["crossing", "crowd"], 2, 7, tmp_path / "own")
+    wide = write_worlds(["crossing", "crowd"], 2, 7, tmp_path / "wide", fov_deg=360.0)
+    assert [p.name for p in own] == [p.name for p in wide]
+    for a, b in zip(own, wide, strict=True):
+        before, after = load_scenario(a), load_scenario(b)
+        assert before.laser.fov_deg == 180.0
+        assert after.laser.fov_deg == 360.0
+        assert after.laser.beam_count == 721
+        assert after.model_dump(exclude={"laser"}) == before.model_dump(exclude={"laser"})
+        assert (after.laser.model_dump(exclude={"fov_deg"})
+                == before.laser.model_dump(exclude={"fov_deg"}))
+
+
+def record(name: str, outcome: str, trajectory: list[list[float]]) -> dict[str, Any]:
+    return {"scenario": name, "planner": "paper", "outcome": outcome, "time": 60.0,
+            "path_length": 3.0, "min_clearance": 0.3, "events": [], "trajectory": trajectory}
+
+
+def standing_from(t_stop: float, t_end: float) -> list[list[float]]:
+    """Driving along x at 1 m/s until ``t_stop``, then standing (0.01 m of jitter)."""
+    rows = []
+    for k in range(round(t_end * 10) + 1):
+        t = k / 10
+        x = min(t, t_stop) + (0.01 if t > t_stop and k % 2 else 0.0)
+        rows.append([t, x, 0.0, 0.0, 0.0])
+    return rows
+
+
+def test_still_at_end_is_the_time_since_the_robot_last_moved() -> None:
+    assert still_at_end(standing_from(40.0, 60.0)) == 20.0
+    assert still_at_end(standing_from(60.0, 60.0)) == 0.0
+    assert still_at_end([]) == 0.0
+
+
+def test_a_timeout_standing_where_a_way_existed_is_stuck_and_fails_the_goal() -> None:
+    records = [record("crowd-1", "timeout", standing_from(30.0, 60.0)),  # stuck
+               record("crowd-2", "timeout", standing_from(55.0, 60.0)),  # still driving
+               record("static-1", "timeout", standing_from(30.0, 60.0)),  # no way there
+               record("static-2", "reached", standing_from(30.0, 60.0)),
+               record("mixed-1", "collision", standing_from(30.0, 60.0))]
+    (paper,), families = summarise(records, ["paper"], lambda name: name != "static-1")
+    assert paper.stuck == ["crowd-1"]
+    line = goal_lines([paper], families)
+    assert "stood still: 1 (crowd-1)" in line
+    assert "NOT met" in line
+    assert "short: crowd 0 %, static 50 %, mixed 0 %" in line
+
+
+def test_the_goal_is_met_when_every_family_reaches_the_target() -> None:
+    records = [record(f"{f}-{k}", "reached", standing_from(30.0, 31.0))
+               for f in ("static", "crowd") for k in range(3)]
+    (paper,), families = summarise(records, ["paper"])
+    assert paper.stuck == []
+    assert goal_lines([paper], families).endswith("stood still: 0 (met).")
