@@ -22,7 +22,11 @@ command as the robot would actually drive it:
    changing heading from the last choice (no dithering between equal options). Contact
    means coming within the robot radius + the mover's radius + half the safety margin
    + the growth; a pass within a further ``comfort`` m costs in proportion. Points the
-   map holds (standing obstacles, inflated) are contact at once.
+   map holds (standing obstacles, inflated) are contact at once. A contact costs more
+   the deeper it goes, up to twice as much where the robot would meet the mover's
+   predicted centre: when every candidate touches some mover's growing clearance (a
+   crosser seen late, a crowd), the one that stays out of the mover's predicted way wins
+   over one that makes more progress by cutting across it.
 
 The local layer's own command stands when its roll-out keeps clear of every mover
 within ``horizon``: the paper's responses are kept whenever they are safe. Otherwise the
@@ -125,7 +129,9 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
     weight = 1.0 / (1.0 + times / s.tau)
     touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
     near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
-    cost_mk = np.where(touch, 10.0, near) * weight  # (n, m, k)
+    # How deep a contact goes: 0 at the clearance's edge, 1 on the mover's predicted centre.
+    depth = np.clip(-gap / clearance[None], 0.0, 1.0)
+    cost_mk = np.where(touch, 10.0 * (1.0 + depth), near) * weight  # (n, m, k)
     cost = cost_mk.max(axis=2).sum(axis=1)
     any_touch: npt.NDArray[np.bool_] = np.any(touch, axis=1)  # (n, k)
     first_k = np.where(np.any(any_touch, axis=1), np.argmax(any_touch, axis=1), -1)
