@@ -92,6 +92,24 @@ class Detour:
     side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
 
 
+def should_be_seen(scan: ScanData, point: tuple[float, float], radius: float) -> bool:
+    """Whether a disc of ``radius`` at ``point`` lies wholly within the scan's field of view
+    and range, with no return nearer than its near face on the beam toward it: if it were
+    there, the laser would see it."""
+    x, y, heading = scan.pose
+    distance = math.hypot(point[0] - x, point[1] - y)
+    if distance <= radius or distance + radius >= scan.range_max:
+        return False
+    bearing = math.remainder(math.atan2(point[1] - y, point[0] - x) - heading, math.tau)
+    half = math.asin(min(radius / distance, 1.0))
+    count = int(scan.ranges.shape[0])
+    angle_max = scan.angle_min + scan.angle_increment * (count - 1)
+    if bearing - half < scan.angle_min or bearing + half > angle_max:
+        return False
+    beam = round((bearing - scan.angle_min) / scan.angle_increment)
+    return bool(scan.ranges[min(max(beam, 0), count - 1)] >= distance - radius - 0.05)
+
+
 def first_in_scan_order(threats: list[Assessment], robot: Vec, heading: float) -> Assessment:
     """The threat Algorithm 1 meets first: O_chain runs in scan order, the paper's 0 to
     180 degrees, right to left; the threat at the smallest bearing from the robot's right
@@ -136,6 +154,9 @@ class Planner:
         self.last_v = 0.0
         self.safety_heading: float | None = None  # the safety stage's last heading
         self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
+        # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).
+        self.last_seen_movers: dict[int, tuple[Obstacle, float]] = {}
+        self.unseen: list[tuple[Obstacle, float]] = []  # (predicted to now, age s)
         if self.start is not None:
             self._set_path(np.vstack([self.start, self.goal]), "start")
 
@@ -447,7 +468,7 @@ class Planner:
 
     def speed_and_safety(
         self, pose: tuple[float, float, float], target: Vec, speed: float,
-        movers: list[Obstacle], path_target: Vec,
+        movers: list[Obstacle], path_target: Vec, ages: list[float] | None = None,
     ) -> safety.Choice:
         """Check driving toward ``target`` at ``speed`` against every mover as the robot
         would drive it (``safety.py``); the local layer's command if it is safe, else the
@@ -461,7 +482,8 @@ class Planner:
             np.array([o.position for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.radius for o in movers], dtype=np.float64),
-            np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64))
+            np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64),
+            None if ages is None else np.asarray(ages, dtype=np.float64))
         settings = safety.Settings(
             horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
             growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
@@ -682,13 +704,17 @@ class Planner:
             else:
                 speed, action, lead = v, act, slowest
 
+        unseen = [(o, age) for o, age in self.unseen
+                  if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
         movers = [o for o in in_window
                   if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
         # Every track typed dynamic, standing ones too: their returns are not in the map.
-        walkers = [o for o in in_window if o.kind == "dynamic"]
-        self.safety_heading = None if not movers else self.safety_heading
-        if p.speed_check and movers and float(np.hypot(*(target - robot))) > 1e-9:
-            choice = self.speed_and_safety(pose, target, speed, walkers, path_target)
+        # Then the movers out of view, predicted from where they were last seen.
+        walkers = [o for o in in_window if o.kind == "dynamic"] + [o for o, _ in unseen]
+        ages = [0.0] * (len(walkers) - len(unseen)) + [age for _, age in unseen]
+        self.safety_heading = None if not (movers or unseen) else self.safety_heading
+        if p.speed_check and (movers or unseen) and float(np.hypot(*(target - robot))) > 1e-9:
+            choice = self.speed_and_safety(pose, target, speed, walkers, path_target, ages)
             if not choice.kept:
                 culprit = walkers[choice.mover] if choice.mover is not None else None
                 ahead = math.atan2(target[1] - robot[1], target[0] - robot[0])
@@ -753,8 +779,13 @@ class Planner:
         live = {ob.id for ob in obstacles}
         self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
         self.sides = {i: side for i, side in self.sides.items() if i in live}
-        self.top_speeds = {ob.id: max(self.top_speeds.get(ob.id, 0.0), math.hypot(*ob.velocity))
-                           for ob in obstacles if ob.kind == "dynamic"}
+        self.top_speeds.update({ob.id: max(self.top_speeds.get(ob.id, 0.0),
+                                           math.hypot(*ob.velocity))
+                                for ob in obstacles if ob.kind == "dynamic"})
+        self.unseen = self.remember_movers(obstacles, stamp, scan)
+        dynamic = {ob.id for ob in obstacles if ob.kind == "dynamic"}
+        self.top_speeds = {i: v for i, v in self.top_speeds.items()
+                           if i in dynamic or (i in self.last_seen_movers and i not in live)}
         robot = np.array(pose[:2], dtype=np.float64)
         if self.start is None:
             self.start = robot.copy()
@@ -800,6 +831,55 @@ class Planner:
         if not self.trail or math.dist(self.trail[-1], robot) >= 0.05:
             self.trail.append((float(robot[0]), float(robot[1])))
             del self.trail[:-400]
+
+    # -- the movers out of view --------------------------------------------------------
+
+    def remember_movers(self, obstacles: list[Obstacle], stamp: float,
+                        scan: ScanData | None) -> list[tuple[Obstacle, float]]:
+        """The movers whose tracks are lost, predicted at constant velocity to ``stamp``,
+        each with the seconds since it was last seen. The 180-degree laser does not see
+        beside and behind the robot: a crosser that leaves its view while the robot turns
+        is still on its way. One is forgotten after ``mover_memory`` s, when the laser
+        should see it where it is predicted and does not, or when a mover tracked now is
+        where it is predicted (seen again, under a new track)."""
+        p = self.p
+        moving = [o for o in obstacles
+                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        live = {o.id for o in obstacles}
+        for ob in moving:
+            self.last_seen_movers[ob.id] = (ob, stamp)
+        kept: dict[int, tuple[Obstacle, float]] = {}
+        unseen: list[tuple[Obstacle, float]] = []
+        for ob_id, (ob, seen) in self.last_seen_movers.items():
+            if ob_id in live:
+                if any(o.id == ob_id for o in moving):
+                    kept[ob_id] = (ob, seen)
+                continue  # tracked, but no longer moving: the track says where it is
+            age = stamp - seen
+            if age > p.mover_memory:
+                continue
+            where = (ob.position[0] + ob.velocity[0] * age, ob.position[1] + ob.velocity[1] * age)
+            reach = ob.radius + p.safety_growth * self.top_speeds.get(ob_id, 0.0) * age
+            if scan is not None and should_be_seen(scan, where, ob.radius):
+                continue
+            if any(self._same_mover(ob, o, where, reach) for o in moving):
+                continue
+            kept[ob_id] = (ob, seen)
+            unseen.append((dataclasses.replace(ob, position=where), age))
+        self.last_seen_movers = kept
+        return unseen
+
+    @staticmethod
+    def _same_mover(lost: Obstacle, track: Obstacle, where: tuple[float, float],
+                    reach: float) -> bool:
+        """Whether ``track`` is plausibly the ``lost`` mover seen again: where it is
+        predicted (within ``reach``), walking about the same way (the velocities differ by
+        at most half the faster speed). A crowd's other walkers pass near a lost one's
+        predicted place too; they do not make it seen again."""
+        if math.dist(track.position, where) > reach + track.radius:
+            return False
+        faster = max(math.hypot(*lost.velocity), math.hypot(*track.velocity))
+        return math.dist(lost.velocity, track.velocity) <= 0.5 * faster
 
     # -- stage: the map ----------------------------------------------------------------
 

@@ -27,6 +27,9 @@ command as the robot would actually drive it:
    predicted centre: when every candidate touches some mover's growing clearance (a
    crosser seen late, a crowd), the one that stays out of the mover's predicted way wins
    over one that makes more progress by cutting across it.
+4. A mover that has left the laser's view (``Movers.ages``: seconds since it was last
+   seen) is predicted from where it was last seen, its clearance grown for the time
+   since as well.
 
 The local layer's own command stands when its roll-out keeps clear of every mover
 within ``horizon``: the paper's responses are kept whenever they are safe. Otherwise the
@@ -57,6 +60,7 @@ class Movers:
     velocities: Vec
     radii: Vec
     top_speeds: Vec
+    ages: Vec | None = None  # s since each was last seen (None: all in view now)
 
     def __len__(self) -> int:
         return int(self.radii.shape[0])
@@ -123,8 +127,9 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
     px = movers.positions[:, 0, None] + movers.velocities[:, 0, None] * times  # (m, k)
     py = movers.positions[:, 1, None] + movers.velocities[:, 1, None] * times
     gap = np.hypot(xs[:, None, :] - px[None], ys[:, None, :] - py[None])  # (n, m, k)
+    ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
     clearance = (robot_radius + movers.radii[:, None] + s.margin / 2
-                 + s.growth * movers.top_speeds[:, None] * times)
+                 + s.growth * movers.top_speeds[:, None] * (ages[:, None] + times))
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
     touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)

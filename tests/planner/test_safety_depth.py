@@ -32,6 +32,20 @@ def test_a_contact_on_the_movers_centre_costs_more_than_one_at_its_clearance_edg
     assert math.isclose(cost[1], 20.0 * w)
 
 
+def test_an_age_grows_the_clearance_as_if_the_mover_had_walked_that_long() -> None:
+    # A mover last seen 2 s ago at 0.5 m/s: growth 0.2 x 0.5 x (2 + t) on top of 0.65 m.
+    t = np.array([0.2])
+    xs, ys = np.array([[0.8]]), np.array([[0.0]])
+    fresh = safety.Movers(np.array([[0.0, 0.0]]), np.zeros((1, 2)), np.array([0.3]),
+                          np.array([0.5]))
+    old = safety.Movers(fresh.positions, fresh.velocities, fresh.radii, fresh.top_speeds,
+                        np.array([2.0]))
+    _, first_fresh, _ = safety.contact_costs(xs, ys, t, fresh, 0.3, SETTINGS)
+    _, first_old, _ = safety.contact_costs(xs, ys, t, old, 0.3, SETTINGS)
+    assert math.isinf(first_fresh[0])  # 0.8 m > 0.65 + 0.2 x 0.5 x 0.2 = 0.67 m
+    assert first_old[0] == 0.2  # 0.8 m < 0.65 + 0.2 x 0.5 x 2.2 = 0.87 m
+
+
 def test_a_crosser_seen_late_is_let_pass_not_cut_in_front_of() -> None:
     # The robot (radius 0.2, top speed 0.2 m/s) stands heading -45 degrees; the path
     # runs east. A walker (radius 0.16) 1.8 m away up and to the right walks down-left at
