@@ -100,7 +100,7 @@ def should_be_seen(scan: ScanData, point: tuple[float, float], radius: float) ->
     distance = math.hypot(point[0] - x, point[1] - y)
     if distance <= radius or distance + radius >= scan.range_max:
         return False
-    bearing = math.remainder(math.atan2(point[1] - y, point[0] - x) - heading, math.tau)
+    bearing = wrap_angle(math.atan2(point[1] - y, point[0] - x) - heading)
     half = math.asin(min(radius / distance, 1.0))
     count = int(scan.ranges.shape[0])
     angle_max = scan.angle_min + scan.angle_increment * (count - 1)
