@@ -30,6 +30,7 @@ from zenav.schemas.messages import (
     TrackList,
     VelocityCommand,
 )
+from zenav.services.perception.params import PerceptionParams
 
 pytestmark = pytest.mark.integration
 
@@ -149,16 +150,29 @@ def test_a_recorded_run_replayed_into_perception_tracking_and_planner_gives_the_
     assert stopped.returncode == 0 and "stopped cleanly" in stopped.stdout, stopped.stderr
     assert span / 2 * 0.9 < took < span / 2 + 10, (span, took)  # at twice the pace
     again = {topic: by_stamp(replayed, topic, kind) for topic, kind in OUTPUTS.items()}
-    # Perception answers each scan from that scan and the odometry alone: the same chain
-    # for every stamp both runs have.
+    # Perception answers each scan from that scan, the odometry and the scans it answered
+    # in the motion cue's memory before it (its longest baseline and a second more): the
+    # same chain for every stamp both runs answered after the same recent scans. A loaded
+    # host may drop a scan in one run and not the other; the chains just after it may
+    # then differ, and are not compared.
     common = recorded["obstacles"].keys() & again["obstacles"].keys()
     assert len(common) >= 0.95 * len(scans)
-    assert all(again["obstacles"][s] == recorded["obstacles"][s] for s in common)
+    memory = max(PerceptionParams().motion_baselines) + 1.0 + 0.05
+
+    def recent(answered: list[float], stamp: float) -> list[float]:
+        return [t for t in answered if stamp - memory < t <= stamp]
+
+    live_answered, replay_answered = sorted(recorded["obstacles"]), sorted(again["obstacles"])
+    comparable = [s for s in common
+                  if recent(live_answered, s) == recent(replay_answered, s)]
+    assert len(comparable) >= 0.8 * len(common), (len(comparable), len(common))
+    assert all(again["obstacles"][s] == recorded["obstacles"][s] for s in comparable)
     # Tracking and the planner carry state from chain to chain: the same outputs as long as
     # they were fed the same chains (everything, unless a loaded host dropped one).
     same = same_prefix(sorted(recorded["obstacles"]), sorted(again["obstacles"]))
     assert len(same) >= 20, "the chains differ from the start"
     for topic in ("tracks", "cmd_vel"):
         assert [again[topic].get(s) for s in same] == [recorded[topic].get(s) for s in same]
-    print(f"replay: {len(common)} of {len(scans)} scans gave the same chain; tracks and "
+    print(f"replay: {len(comparable)} of {len(scans)} scans answered after the same recent "
+          f"scans gave the same chain ({len(common)} answered in both runs); tracks and "
           f"commands identical over {len(same)} chains")
