@@ -109,7 +109,6 @@ class Costmap:
         self._refreshed: tuple[int, float] | None = None  # (version, now) of the cache
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None
-        self._scratch = np.empty(0)  # reused by the ray tracing
         self._returned = np.zeros(0, dtype=bool)  # per flat cell: a return of this scan
 
     # -- geometry ----------------------------------------------------------------------
@@ -284,9 +283,8 @@ class Costmap:
             return self._inflated
         self._refreshed = (self.version, self.now)
         lethal = self.lethal()
-        # The inflation depends on the lethal set alone: compare the set itself (decay
-        # and confirmation change it without an update, and an update with confirmation
-        # bumps the version on every scan though the set mostly stays the same).
+        # The inflation depends on the lethal set alone: compare the set itself (every
+        # update bumps the version, though the set mostly stays the same).
         if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
             return self._inflated
         if lethal.any():

@@ -315,6 +315,14 @@ class Planner:
                               distance - self.p.map_resolution, self.p.map_resolution / 2)
         return not bool(self.costmap.blocked_at(samples).any())
 
+    def _threats(self, notes: list[Assessment], clear: bool, stamp: float
+                 ) -> list[Assessment]:
+        """The assessments to answer: threats of a known type, confirmed, and not a (b)
+        on an obstacle the map holds while the map finds the way clear (``clear``)."""
+        return [self._sticky(a) for a in notes
+                if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
+                and not (a.letter == "b" and clear and self._mapped(a, stamp))]
+
     def _mapped(self, a: Assessment, stamp: float) -> bool:
         """Whether a standing obstacle has been seen long enough to be in the map, and
         the map holds it: an occupied cell within its radius of its centre, or within
@@ -625,19 +633,14 @@ class Planner:
         # The map may clear the way to the target (the path's look-ahead point, or the
         # detour's sub-target); whether a detour may end is still the boxes' call.
         clear = self._map_clear(robot, target, to_goal=self.detour is None)
-        threats = [self._sticky(a) for a in notes
-                   if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
-                   and not (a.letter == "b" and clear and self._mapped(a, stamp))]
+        threats = self._threats(notes, clear, stamp)
         if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
                                                              in_window, stamp):
             # The path now goes round what the map holds: judge the way along it again.
             path_target = target = self.path_target(robot, self._statics(in_window))
             notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
             clear = self._map_clear(robot, target, to_goal=True)
-            threats = [self._sticky(a) for a in notes
-                       if a.threat and a.obstacle.kind != "new"
-                       and not self._unconfirmed(a, stamp)
-                       and not (a.letter == "b" and clear and self._mapped(a, stamp))]
+            threats = self._threats(notes, clear, stamp)
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
@@ -848,11 +851,12 @@ class Planner:
         live = {o.id for o in obstacles}
         for ob in moving:
             self.last_seen_movers[ob.id] = (ob, stamp)
+        moving_ids = {o.id for o in moving}
         kept: dict[int, tuple[Obstacle, float]] = {}
         unseen: list[tuple[Obstacle, float]] = []
         for ob_id, (ob, seen) in self.last_seen_movers.items():
             if ob_id in live:
-                if any(o.id == ob_id for o in moving):
+                if ob_id in moving_ids:
                     kept[ob_id] = (ob, seen)
                 continue  # tracked, but no longer moving: the track says where it is
             age = stamp - seen

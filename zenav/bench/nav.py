@@ -299,8 +299,12 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     for r in records:
         if r["outcome"] == "error":
             echo(f"run failed: {r['planner']} {r['scenario']}: {r.get('error')}")
-    ways = {p.stem: solvable(load_scenario(p)) for p in paths}
-    summaries, per_family = summarise(records, planners, lambda name: ways.get(name, True))
+    world_files = {p.stem: p for p in paths}  # the flood fill only for runs that stood
+
+    def has_way(name: str) -> bool:
+        return name not in world_files or solvable(load_scenario(world_files[name]))
+
+    summaries, per_family = summarise(records, planners, has_way)
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
                                    f" --families {','.join(families)}")
