@@ -393,6 +393,10 @@ def _command(args: argparse.Namespace) -> int:
     from zenav.run import RunError
 
     profiles = PROFILES if args.profile == "both" else (args.profile,)
+    for flag, value, least in (("--jobs", args.parallel, 1), ("--verify", args.verify, 0)):
+        if value < least:
+            print(f"zenav paper: {flag} must be >= {least} (got {value})", file=sys.stderr)
+            return 2
     try:
         report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
                       reuse=args.reuse, engine=args.engine, verify=args.verify)

@@ -267,14 +267,20 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     from zenav.services.runner import PLANNERS
 
     unknown = [p for p in planners if p not in PLANNERS]
-    if unknown:
-        raise ValueError(f"unknown planner {', '.join(unknown)}; choose from "
-                         f"{', '.join(PLANNERS)}")
+    if unknown or not planners:
+        raise ValueError(f"unknown planner {', '.join(unknown) or '(none given)'}; choose "
+                         f"from {', '.join(PLANNERS)}")
     families = [f for name in families for f in (UNSEEN if name == "unseen" else (name,))]
     bad = [f for f in families if f not in KNOWN]
-    if bad:
-        raise ValueError(f"unknown family {', '.join(bad)}; choose from {', '.join(KNOWN)} "
-                         "or unseen (all the unseen-* classes)")
+    if bad or not families:
+        raise ValueError(f"unknown family {', '.join(bad) or '(none given)'}; choose from "
+                         f"{', '.join(KNOWN)} or unseen (all the unseen-* classes)")
+    if worlds < 1:
+        raise ValueError(f"--worlds must be >= 1 (got {worlds})")
+    if jobs < 1:
+        raise ValueError(f"--jobs must be >= 1 (got {jobs})")
+    if verify < 0:
+        raise ValueError(f"--verify must be >= 0 (got {verify})")
     if fov_deg is not None and not (0 < fov_deg <= 360 and (2 * fov_deg).is_integer()):
         raise ValueError(f"--fov must be in (0, 360] in half degrees (got {fov_deg:g})")
     out.mkdir(parents=True, exist_ok=True)
