@@ -43,7 +43,7 @@ import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import clear_beams
+from zenav.services.planner._loops import return_bounds, trace_scan
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -109,7 +109,7 @@ class Costmap:
         self._refreshed: tuple[int, float] | None = None  # (version, now) of the cache
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None
-        self._returned = np.zeros(0, dtype=bool)  # per flat cell: a return of this scan
+        self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -136,14 +136,22 @@ class Costmap:
         blocks of ``padding``), never beyond ``max_size`` a side."""
         if len(points) == 0:
             return
+        lo = np.min(points, axis=0)
+        hi = np.max(points, axis=0)
+        self._grow_to_box(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), margin)
+
+    def _grow_to_box(self, x_lo: float, y_lo: float, x_hi: float, y_hi: float,
+                     margin: float) -> None:
+        """``grow_to`` the points of the box [x_lo, x_hi] x [y_lo, y_hi]."""
         r = self.resolution
         nx, ny = self.shape
-        lo = np.min(points, axis=0) - margin
-        hi = np.max(points, axis=0) + margin
-        top = self.origin + np.array([nx, ny]) * r
-        if (self.origin[0] <= lo[0] and self.origin[1] <= lo[1] and hi[0] <= top[0]
-                and hi[1] <= top[1]):
+        ox, oy = float(self.origin[0]), float(self.origin[1])
+        if (ox <= x_lo - margin and oy <= y_lo - margin and x_hi + margin <= ox + nx * r
+                and y_hi + margin <= oy + ny * r):
             return  # inside already (what the growth below would find, cheaper)
+        lo = np.array([x_lo, y_lo]) - margin
+        hi = np.array([x_hi, y_hi]) + margin
+        top = self.origin + np.array([nx, ny]) * r
         add_lo = np.maximum(np.ceil((self.origin - lo) / self.padding), 0) * self.padding
         add_hi = np.maximum(np.ceil((hi - top) / self.padding), 0) * self.padding
         if not (add_lo.any() or add_hi.any()):
@@ -176,49 +184,33 @@ class Costmap:
         tracks typed dynamic; returns inside them are not marked."""
         self.now = max(self.now, stamp)
         x, y, heading = scan.pose
-        ranges = np.asarray(scan.ranges, dtype=np.float64)
+        ranges = np.ascontiguousarray(scan.ranges, dtype=np.float64)
         alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
-        hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
-        ends = np.column_stack(to_global(scan.pose, ranges, alpha))  # Eq. 1
-        # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the robot).
+        # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
+        # robot); a return lies at the robot plus its range times that (Eq. 1 again).
         ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
-        self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
-                     self.padding / 2)
-        # Hits, except those on a mover.
-        marks = ends[hit]
-        if movers and len(marks):
-            discs = np.asarray(movers, dtype=np.float64).reshape(-1, 3)
-            gap = np.hypot(marks[:, None, 0] - discs[None, :, 0],
-                           marks[:, None, 1] - discs[None, :, 1]) - discs[None, :, 2]
-            marks = marks[(gap > self.resolution).all(axis=1)]
-        hits = self.cell_of(marks)
-        hits = hits[self.inside(hits)]
+        ux, uy = np.ascontiguousarray(ux), np.ascontiguousarray(uy)
+        box = return_bounds(x, y, ux, uy, ranges, scan.range_min, scan.range_max)
+        self._grow_to_box(*box, self.padding / 2)
         nx, ny = self.shape
-        # Free space: every half cell along each beam, stopping half a cell short of
-        # its return (a beam with no return clears up to its reach), in compiled code
-        # (``_loops.clear_beams``).
-        # A cell a return of this scan falls in is not cleared by this scan: along a
-        # straight wall, the beams that meet it at a grazing angle pass through the face
-        # cells the others return from, and clearing them would restart their
-        # confirmation on every scan (a wall seen side-on would never be confirmed).
-        step = self.resolution / 2
-        # (never beyond the laser's reach: a range above it must not make a beam endless)
-        reach = np.minimum(np.where(hit, ranges - step, ranges), scan.range_max)
         if self._returned.size != nx * ny:
-            self._returned = np.zeros(nx * ny, dtype=bool)
-        hit_flat = hits[:, 0] * ny + hits[:, 1]
-        self._returned[hit_flat] = True
-        clear_beams(x, y, np.ascontiguousarray(ux), np.ascontiguousarray(uy), reach, step,
-                    float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
-                    self._returned.view(np.uint8), stamp, _flat(self.seen),
-                    _flat(self.occupied).view(np.uint8), _flat(self.walls).view(np.uint8))
-        self._returned[hit_flat] = False  # all False again for the next scan
-        newly = ~self.occupied[hits[:, 0], hits[:, 1]]
-        self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
-        self.seen[hits[:, 0], hits[:, 1]] = stamp
-        self.occupied[hits[:, 0], hits[:, 1]] = True
-        confirmed = self.hit_since[hits[:, 0], hits[:, 1]] <= stamp - self.confirm
-        self.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
+            self._returned = np.zeros(nx * ny, dtype=np.uint8)
+        discs = np.asarray(movers if movers else [], dtype=np.float64).reshape(-1, 3)
+        # Compiled (``_loops.trace_scan``), in three steps:
+        # - the marks: the cells of the returns, except those on a mover;
+        # - free space: every half cell along each beam, stopping half a cell short of
+        #   its return (a beam with no return clears up to its reach, never beyond the
+        #   laser's: a range above it must not make a beam endless), except the marked
+        #   cells: along a straight wall, the beams that meet it at a grazing angle pass
+        #   through the face cells the others return from, and clearing them would
+        #   restart their confirmation on every scan (a wall seen side-on would never be
+        #   confirmed);
+        # - the marking: occupied now, a wall once occupied for ``confirm`` seconds.
+        trace_scan(x, y, ux, uy, ranges, scan.range_min, scan.range_max, discs,
+                   float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
+                   self._returned, stamp, self.confirm, _flat(self.seen),
+                   _flat(self.occupied).view(np.uint8), _flat(self.hit_since),
+                   _flat(self.walls).view(np.uint8))
         self.version += 1
 
     def forget_older_than(self, stamp: float, keep: tuple[Vec, float] | None = None) -> None:
