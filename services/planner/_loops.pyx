@@ -140,6 +140,22 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
             walls[cell] = 1
 
 
+def look_up(const double[:, ::1] points, double ox, double oy, double resolution,
+            const unsigned char[::1] grid, Py_ssize_t ny, unsigned char outside,
+            unsigned char[::1] out):
+    """For each point (x, y), the flag of the cell it falls in (``Costmap.cell_of``'s
+    arithmetic) in the flat grid (``ny`` cells a column), or ``outside`` beyond it."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, ix, iy
+    for i in range(points.shape[0]):
+        ix = cell_index(points[i, 0] - ox, resolution)
+        iy = cell_index(points[i, 1] - oy, resolution)
+        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+            out[i] = grid[ix * ny + iy]
+        else:
+            out[i] = outside
+
+
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,
           double y0, double theta0, double v0, double gain, double max_omega,
           double accel, double decel, double[:, ::1] xs, double[:, ::1] ys):

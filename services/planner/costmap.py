@@ -43,7 +43,7 @@ import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import return_bounds, trace_scan
+from zenav.services.planner._loops import look_up, return_bounds, trace_scan
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -309,19 +309,18 @@ class Costmap:
         """Whether each point (n, 2) lies in a blocked cell; a point beyond the grid is
         ``outside`` (free by default: the local checks near the robot, which the grid
         always holds with room to spare; the global path passes True)."""
-        cells = self.cell_of(points)
-        ok = self.inside(cells)
-        out = np.full(len(cells), outside, dtype=bool)
-        grid = self.blocked()
-        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
-        return out
+        return self._look_up(points, self.blocked(), outside)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
-        cells = self.cell_of(points)
-        ok = self.inside(cells)
-        out = np.zeros(len(cells), dtype=bool)
-        grid = self._refresh()[0]
-        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return self._look_up(points, self._refresh()[0], False)
+
+    def _look_up(self, points: Vec, grid: BoolGrid, outside: bool) -> npt.NDArray[np.bool_]:
+        """The flag of the cell of each point (n, 2) in ``grid`` (``cell_of``), or
+        ``outside`` beyond the grid, in compiled code (``_loops.look_up``)."""
+        xy = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        out = np.empty(len(xy), dtype=bool)
+        look_up(xy, float(self.origin[0]), float(self.origin[1]), self.resolution,
+                _flat(grid).view(np.uint8), self.shape[1], outside, out.view(np.uint8))
         return out
 
     def values(self) -> npt.NDArray[np.int8]:

@@ -139,3 +139,32 @@ def test_the_cell_index_is_the_floor_of_the_quotient() -> None:
     out = np.empty(offsets.size, dtype=np.int_)
     floor_quotients(offsets, resolution, out)
     assert np.array_equal(out, np.floor(offsets / resolution).astype(np.int64))
+
+
+def test_the_map_looks_points_up_as_cell_of_and_inside_do() -> None:
+    """``blocked_at`` and ``lethal_at`` (compiled ``look_up``) against the numpy look-up
+    they replaced: points inside and beyond the grid, on cell edges, and nan."""
+    rng = np.random.default_rng(5)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
+                       math.pi / 180, 8.0), 0.0)
+    edges = np.column_stack([np.arange(-12, 52) * 0.1, np.arange(-12, 52)[::-1] * 0.1])
+    points = np.vstack([rng.uniform(-3.0, 8.0, (2000, 2)), edges,
+                        [[np.nan, 1.0], [1.0, np.nan], [np.inf, 0.0]]])
+
+    def numpy_look_up(grid: np.ndarray, outside: bool) -> np.ndarray:
+        with np.errstate(invalid="ignore"):
+            cells = cm.cell_of(points)
+        ok = cm.inside(cells)
+        out = np.full(len(cells), outside, dtype=bool)
+        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return out
+
+    for outside in (False, True):
+        blocked = cm.blocked_at(points, outside=outside)
+        assert np.array_equal(blocked, numpy_look_up(cm.blocked(), outside))
+    lethal = cm.lethal_at(points)
+    assert np.array_equal(lethal, numpy_look_up(cm.lethal_grid(), False))
+    assert lethal.any() and blocked.any() and not blocked.all()
+
