@@ -14,7 +14,7 @@ indices as numpy has them), so the results are the same to the bit. The Python c
 import numpy as np
 
 cimport cython
-from libc.math cimport cos, hypot, sin
+from libc.math cimport cos, hypot, sin, sqrt
 
 include "../_angles.pxi"
 
@@ -154,6 +154,76 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
             out[i] = grid[ix * ny + iy]
         else:
             out[i] = outside
+
+
+@cython.cdivision(True)
+cdef inline long long floor_div(long long a, long long b) noexcept nogil:
+    """``a // b`` rounded down, as Python's, for ``b > 0``."""
+    cdef long long q = a // b  # (C's: toward zero)
+    return q - ((a % b != 0) & (a < 0))
+
+
+def distance_cells(const unsigned char[::1] target, Py_ssize_t ny, double scale,
+                   double[::1] out):
+    """For each cell of the flat grid (``ny`` cells a column), ``scale`` times the
+    Euclidean distance in cells from its centre to the nearest cell ``target`` flags
+    (0 on one), as ``scipy.ndimage.distance_transform_edt(~target) * scale``: the
+    squared distance is found exactly in whole numbers (along the first index, then
+    the lower envelope of parabolas along the second: Meijster et al. 2000), and its
+    square root taken in doubles, as scipy does. At least one cell must be flagged."""
+    cdef Py_ssize_t nx = target.shape[0] // ny
+    cdef long long far = nx + ny  # beyond any distance within the grid
+    cdef Py_ssize_t i, j, q, u, row
+    cdef long long w, d, gs, gu
+    # g[i, j]: distance along the first index to a flagged cell of the same j (down,
+    # then up, a row of the grid at a time)
+    g_array = np.empty(nx * ny, dtype=np.int64)
+    cdef long long[::1] g = g_array
+    for j in range(ny):
+        g[j] = 0 if target[j] else far
+    for i in range(1, nx):
+        row = i * ny
+        for j in range(ny):
+            g[row + j] = 0 if target[row + j] else min(g[row - ny + j] + 1, far)
+    for i in range(nx - 2, -1, -1):
+        row = i * ny
+        for j in range(ny):
+            g[row + j] = min(g[row + j], g[row + ny + j] + 1)
+    # along each row: the least (j - u)^2 + g[i, u]^2 over u, by the lower envelope of
+    # those parabolas
+    starts = np.empty(ny, dtype=np.int64)
+    apexes = np.empty(ny, dtype=np.int64)
+    cdef long long[::1] t = starts  # where each parabola of the envelope starts to win
+    cdef long long[::1] s = apexes  # the apex of each
+    for i in range(nx):
+        row = i * ny
+        q = 0
+        s[0] = 0
+        t[0] = 0
+        for u in range(1, ny):
+            gu = g[row + u]
+            while q >= 0:
+                gs = g[row + s[q]]
+                if (t[q] - s[q]) * (t[q] - s[q]) + gs * gs <= (t[q] - u) * (t[q] - u) + gu * gu:
+                    break
+                q -= 1
+            if q < 0:
+                q = 0
+                s[0] = u
+                t[0] = 0
+            else:
+                gs = g[row + s[q]]
+                w = 1 + floor_div(u * u - s[q] * s[q] + gu * gu - gs * gs, 2 * (u - s[q]))
+                if w < ny:
+                    q += 1
+                    s[q] = u
+                    t[q] = w
+        for u in range(ny - 1, -1, -1):
+            gs = g[row + s[q]]
+            d = (u - s[q]) * (u - s[q]) + gs * gs
+            out[row + u] = sqrt(<double>d) * scale
+            if u == t[q]:
+                q -= 1
 
 
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,

@@ -16,9 +16,10 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   not the space beyond the grid: the global path never leaves it (the grid holds start,
   goal, the robot and every return with half the padding to spare; only ``max_size``
   can leave one out);
-- occupied cells are inflated by the robot radius plus a margin with a Euclidean distance
-  transform (scipy.ndimage), so a path through the free cells keeps the robot's disc
-  clear of everything the map holds;
+- occupied cells are inflated by the robot radius plus a margin with an exact Euclidean
+  distance transform (compiled, ``_loops.distance_cells``: scipy.ndimage's to the bit),
+  so a path through the free cells keeps the robot's disc clear of everything the map
+  holds;
 - apart from the map the path is planned on, a wall memory keeps every confirmed
   obstacle cell until a beam passes through it (no decay, no recovery clearing):
   ``cut_off`` asks it whether the walls ever seen close the goal off from the robot.
@@ -40,10 +41,10 @@ from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
-from scipy.ndimage import distance_transform_edt, label
+from scipy.ndimage import label
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import look_up, return_bounds, trace_scan
+from zenav.services.planner._loops import distance_cells, look_up, return_bounds, trace_scan
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -247,8 +248,7 @@ class Costmap:
             return False  # beyond the grid: no knowledge, no verdict
         if not self.walls.any():
             return False
-        gap = np.asarray(distance_transform_edt(~self.walls), dtype=np.float64)
-        free = gap * self.resolution > clearance
+        free = self._distances(self.walls) > clearance
         labels, _ = label(free)
         reach = math.ceil(clearance / self.resolution) + 1
 
@@ -258,6 +258,15 @@ class Costmap:
             return set(np.unique(window[window > 0]).tolist())
 
         return not near(ends[0]) & near(ends[1])
+
+    def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
+        """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
+        one), m: the Euclidean distance transform, exact, in compiled code
+        (``_loops.distance_cells``, scipy's ``distance_transform_edt`` to the bit)."""
+        out = np.empty(self.shape)
+        distance_cells(_flat(np.ascontiguousarray(cells)).view(np.uint8), self.shape[1],
+                       self.resolution, _flat(out))
+        return out
 
     def known(self) -> BoolGrid:
         return np.asarray(self.seen >= self.now - self.decay)
@@ -280,7 +289,7 @@ class Costmap:
         if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
             return self._inflated
         if lethal.any():
-            gap = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * self.resolution
+            gap = self._distances(lethal)
             blocked = np.asarray(gap <= self.inflation)
         else:
             gap = np.full(lethal.shape, math.inf)
