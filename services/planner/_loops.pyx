@@ -226,6 +226,21 @@ def distance_cells(const unsigned char[::1] target, Py_ssize_t ny, double scale,
                 q -= 1
 
 
+def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
+                const long[::1] di, const long[::1] dj, unsigned char[::1] out):
+    """Flag in ``out`` (the flat grid, ``ny`` cells a column) every cell within the
+    grid at an offset ``(di[k], dj[k])`` from one of the ``centres`` (flat indices)."""
+    cdef Py_ssize_t c, k, i, j, a, b
+    for c in range(centres.shape[0]):
+        i = centres[c] // ny
+        j = centres[c] % ny
+        for k in range(di.shape[0]):
+            a = i + di[k]
+            b = j + dj[k]
+            if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
+                out[a * ny + b] = 1
+
+
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,
           double y0, double theta0, double v0, double gain, double max_omega,
           double accel, double decel, double[:, ::1] xs, double[:, ::1] ys):

@@ -44,7 +44,13 @@ import numpy.typing as npt
 from scipy.ndimage import label
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import distance_cells, look_up, return_bounds, trace_scan
+from zenav.services.planner._loops import (
+    distance_cells,
+    look_up,
+    return_bounds,
+    stamp_discs,
+    trace_scan,
+)
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -73,6 +79,19 @@ def _flat(grid: npt.NDArray[G]) -> npt.NDArray[G]:
     flat = grid.reshape(-1)
     assert flat.base is grid or flat.base is grid.base
     return flat
+
+
+def _disc_offsets(resolution: float, inflation: float) -> tuple[npt.NDArray[np.int_],
+                                                               npt.NDArray[np.int_]]:
+    """The cell offsets (di, dj) whose centres lie within ``inflation`` of a cell's, as
+    the distance transform's test has it: ``sqrt(di^2 + dj^2) * resolution <=
+    inflation`` in doubles (the offsets inflation blocks round a lethal cell)."""
+    reach = math.ceil(max(inflation, 0.0) / resolution) + 1
+    pairs = [(di, dj) for di in range(-reach, reach + 1) for dj in range(-reach, reach + 1)
+             if math.sqrt(float(di * di + dj * dj)) * resolution <= inflation]
+    di = np.array([p[0] for p in pairs], dtype=np.int_)
+    dj = np.array([p[1] for p in pairs], dtype=np.int_)
+    return di, dj
 
 
 class Costmap:
@@ -109,7 +128,8 @@ class Costmap:
         self.version = 0  # bumped whenever the grids change
         self._refreshed: tuple[int, float] | None = None  # (version, now) of the cache
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
-        self._gap: npt.NDArray[np.float64] | None = None
+        self._gap: npt.NDArray[np.float64] | None = None  # of _inflated's lethal cells
+        self._disc = _disc_offsets(resolution, inflation)
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
 
     # -- geometry ----------------------------------------------------------------------
@@ -288,14 +308,19 @@ class Costmap:
         # update bumps the version, though the set mostly stays the same).
         if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
             return self._inflated
-        if lethal.any():
-            gap = self._distances(lethal)
-            blocked = np.asarray(gap <= self.inflation)
-        else:
-            gap = np.full(lethal.shape, math.inf)
+        # The blocked cells are those within the inflation distance of a lethal one;
+        # the distances themselves (``gap``) only when asked: most cycles need none.
+        # Few lethal cells: each one's disc of blocked cells; many: the distances.
+        centres = np.flatnonzero(lethal)
+        di, dj = self._disc
+        if len(centres) * len(di) <= 4 * lethal.size:
             blocked = np.zeros_like(lethal)
+            stamp_discs(centres, *self.shape, di, dj, _flat(blocked).view(np.uint8))
+            self._gap = None
+        else:
+            self._gap = self._distances(lethal)
+            blocked = np.asarray(self._gap <= self.inflation)
         self._inflated = (lethal, blocked)
-        self._gap = gap
         return lethal, blocked
 
     def lethal_grid(self) -> BoolGrid:
@@ -310,8 +335,10 @@ class Costmap:
     def gap(self) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest occupied one, m (inf
         when none is known)."""
-        self._refresh()
-        assert self._gap is not None
+        lethal = self._refresh()[0]
+        if self._gap is None:
+            self._gap = (self._distances(lethal) if lethal.any()
+                         else np.full(lethal.shape, math.inf))
         return self._gap
 
     def blocked_at(self, points: Vec, *, outside: bool = False) -> npt.NDArray[np.bool_]:

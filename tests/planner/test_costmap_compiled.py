@@ -194,3 +194,27 @@ def test_the_distance_transform_is_scipys_to_the_bit(seed: int) -> None:
     expected = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * cm.resolution
     assert cm.gap().tobytes() == expected.tobytes()
     assert np.array_equal(cm.blocked(), expected <= cm.inflation)
+
+
+@pytest.mark.parametrize("inflation", [0.0, 0.1, 0.3, 0.35, 0.45, 1.2])
+@pytest.mark.parametrize("many", [False, True])
+def test_the_blocked_cells_are_those_within_the_inflation_by_the_distance_transform(
+        inflation: float, many: bool) -> None:
+    """The blocked cells, stamped as discs round few lethal cells or read off the
+    distances when there are many, are the cells whose scipy distance times the
+    resolution is within the inflation (in doubles: at 0.3 m on a 0.1 m grid the cell
+    3 cells away is 0.30000000000000004 m off, not blocked)."""
+    rng = np.random.default_rng(int(inflation * 100) + many)
+    cm = Costmap((0.0, 0.0), (5.0, 4.0), resolution=0.1, decay=60.0, inflation=inflation,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    ranges = rng.uniform(0.3, 1.2 if many else 5.0, 721 if many else 61)
+    cm.update(ScanData((2.0, 2.0, 0.0), ranges, -math.pi, 2 * math.pi / (len(ranges) - 1),
+                       8.0), 0.0)
+    lethal = cm.lethal_grid()
+    di, _ = cm._disc
+    by_distances = np.count_nonzero(lethal) * len(di) > 4 * lethal.size
+    if not many or inflation > 1:
+        assert by_distances == many  # each way is taken
+    expected = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * 0.1
+    assert np.array_equal(cm.blocked(), expected <= inflation)
+    assert cm.gap().tobytes() == expected.tobytes()
