@@ -353,7 +353,7 @@ class Tracker:
                 # in front or by the window edge neither grows nor shrinks it.
                 if not m.partial:
                     t.box = _union(t.box, m.box)
-                    t.area = int(box_area(np.array(t.box)))
+                    t.area = int(box_area(t.box))
                     t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
@@ -413,8 +413,9 @@ class Tracker:
         dist = np.sqrt(dx * dx + dy * dy)
         cost = np.where(dist <= gate[None, :], dist, _NO_MATCH)
         rows, cols = linear_sum_assignment(cost)
-        for r, c in zip(rows.tolist(), cols.tolist(), strict=True):
-            if cost[r, c] < _NO_MATCH:
+        matched = (cost[rows, cols] < _NO_MATCH).tolist()
+        for r, c, ok in zip(rows.tolist(), cols.tolist(), matched, strict=True):
+            if ok:
                 owner[r] = c
         return owner
 
