@@ -16,10 +16,10 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   not the space beyond the grid: the global path never leaves it (the grid holds start,
   goal, the robot and every return with half the padding to spare; only ``max_size``
   can leave one out);
-- occupied cells are inflated by the robot radius plus a margin with an exact Euclidean
-  distance transform (compiled, ``_loops.distance_cells``: scipy.ndimage's to the bit),
-  so a path through the free cells keeps the robot's disc clear of everything the map
-  holds;
+- occupied cells are inflated by the robot radius plus a margin (each occupied cell's
+  disc of cells stamped, or with many of them scipy.ndimage's Euclidean distance
+  transform: the same cells), so a path through the free cells keeps the robot's disc
+  clear of everything the map holds;
 - apart from the map the path is planned on, a wall memory keeps every confirmed
   obstacle cell until a beam passes through it (no decay, no recovery clearing):
   ``cut_off`` asks it whether the walls ever seen close the goal off from the robot.
@@ -41,11 +41,10 @@ from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
-from scipy.ndimage import label
+from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
-    distance_cells,
     look_up,
     return_bounds,
     stamp_discs,
@@ -281,12 +280,8 @@ class Costmap:
 
     def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
-        one), m: the Euclidean distance transform, exact, in compiled code
-        (``_loops.distance_cells``, scipy's ``distance_transform_edt`` to the bit)."""
-        out = np.empty(self.shape)
-        distance_cells(_flat(np.ascontiguousarray(cells)).view(np.uint8), self.shape[1],
-                       self.resolution, _flat(out))
-        return out
+        one), m: scipy's Euclidean distance transform."""
+        return np.asarray(distance_transform_edt(~cells), dtype=np.float64) * self.resolution
 
     def known(self) -> BoolGrid:
         return np.asarray(self.seen >= self.now - self.decay)

@@ -12,7 +12,7 @@ import pytest
 from scipy.ndimage import distance_transform_edt
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import distance_cells, floor_quotients
+from zenav.services.planner._loops import floor_quotients
 from zenav.services.planner.costmap import Costmap, ScanData
 
 Mover = tuple[float, float, float]
@@ -172,19 +172,10 @@ def test_the_map_looks_points_up_as_cell_of_and_inside_do() -> None:
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_the_distance_transform_is_scipys_to_the_bit(seed: int) -> None:
-    """``distance_cells`` (the inflation's and the wall memory's distances) against
-    ``scipy.ndimage.distance_transform_edt``: grids from one cell wide to wide ones, from a
-    single flagged cell to nearly all, and the map's own grids through ``gap``."""
+def test_the_maps_distances_and_blocked_cells_are_scipys(seed: int) -> None:
+    """``gap`` (asked after the stamping) and ``blocked`` on the map's own grid, against
+    ``scipy.ndimage.distance_transform_edt`` of its lethal cells."""
     rng = np.random.default_rng(seed)
-    for _ in range(150):
-        nx, ny = (int(v) for v in rng.integers(1, 45, 2))
-        flagged = rng.random((nx, ny)) < rng.choice([0.002, 0.02, 0.1, 0.4, 0.9])
-        flagged[rng.integers(nx), rng.integers(ny)] = True
-        out = np.empty(nx * ny)
-        distance_cells(flagged.reshape(-1).view(np.uint8), ny, 0.1, out)
-        expected = np.asarray(distance_transform_edt(~flagged), dtype=np.float64) * 0.1
-        assert out.reshape(nx, ny).tobytes() == expected.tobytes()
     cm = Costmap((0.0, 0.0), (5.0, 4.0), resolution=0.05, decay=60.0, inflation=0.3,
                  confirm=0.0, padding=1.0, max_size=30.0)
     cm.update(ScanData((1.0, 1.0, 0.4), rng.uniform(0.5, 5.0, 361), -math.pi, math.pi / 180,
