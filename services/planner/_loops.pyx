@@ -1,47 +1,174 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""The planner's two sequential inner loops, compiled (Cython, built at install).
+"""The planner's sequential inner loops, compiled (Cython, built at install).
 
-numpy runs these as one pass over whole arrays per step, which costs more in call
-overhead than in arithmetic: a ray per beam over the map (about 58,000 samples a scan)
-and the unicycle roll-out of every safety candidate over the horizon. Here they are
-plain loops with the same floating-point operations, in the same order, as the numpy
-code they replaced (angles wrapped by ``_angles.pxi``), so the results are the same to
-the bit. The Python callers (``costmap.py``, ``safety.py``) own the
-meaning; ``_loops.pyi`` gives their types.
+numpy ran these as one pass over whole arrays per step, which costs more in call
+overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
+over the map, about 41,000 samples a scan in the perf world, and the marking) and the
+unicycle roll-out of every safety candidate over the horizon. Here they are plain loops
+with the same floating-point operations, in the same order, as the numpy code they
+replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors of the cell
+indices as numpy has them), so the results are the same to the bit. The Python callers
+(``costmap.py``, ``safety.py``) own the meaning; ``_loops.pyi`` gives their types.
 """
 
-from libc.math cimport cos, floor, sin
+import numpy as np
+
+cimport cython
+from libc.math cimport cos, hypot, sin, sqrt
 
 include "../_angles.pxi"
 
 
-def clear_beams(double x, double y, const double[::1] ux, const double[::1] uy,
-                const double[::1] reach, double step, double ox, double oy,
-                double resolution, Py_ssize_t ny, const unsigned char[::1] returned,
-                double stamp, double[::1] seen, unsigned char[::1] occupied,
-                unsigned char[::1] walls):
-    """Mark free, seen at ``stamp``, every cell of the flat grids (``ny`` cells a
-    column) that a point ``s = 0, step, 2 step, ...`` m along a beam from (x, y) falls
-    in, up to the beam's ``reach`` (direction ``(ux, uy)``), except the cells
-    ``returned`` flags. A cell is found with the arithmetic of ``Costmap.cell_of``."""
+@cython.cdivision(True)
+cdef inline Py_ssize_t cell_index(double offset, double resolution) noexcept nogil:
+    """``floor(offset / resolution)`` as an integer, as ``Costmap.cell_of`` has it,
+    without a call to ``floor``: the quotient truncated toward zero, one less if that
+    is above it (a negative quotient with a fraction). (``resolution`` is never 0: the
+    map's own arithmetic divides by it first.)"""
+    cdef double q = offset / resolution
+    cdef Py_ssize_t i = <Py_ssize_t>q
+    return i - (i > q)
+
+
+def floor_quotients(const double[::1] offsets, double resolution, long[::1] out):
+    """``cell_index`` of every offset into ``out`` (for the tests that pin it to
+    ``np.floor(offsets / resolution)``)."""
+    cdef Py_ssize_t i
+    for i in range(offsets.shape[0]):
+        out[i] = cell_index(offsets[i], resolution)
+
+
+def return_bounds(double x, double y, const double[::1] ux, const double[::1] uy,
+                  const double[::1] ranges, double range_min, double range_max):
+    """(x_lo, y_lo, x_hi, y_hi): the box of the robot at (x, y) and every return
+    (a range in [range_min, range_max)) at ``x + range * ux``, ``y + range * uy``."""
+    cdef double x_lo = x, x_hi = x, y_lo = y, y_hi = y, px, py
+    cdef Py_ssize_t b
+    for b in range(ranges.shape[0]):
+        if not (ranges[b] < range_max and ranges[b] >= range_min):
+            continue
+        px = x + ranges[b] * ux[b]
+        py = y + ranges[b] * uy[b]
+        x_lo = min(x_lo, px)
+        x_hi = max(x_hi, px)
+        y_lo = min(y_lo, py)
+        y_hi = max(y_hi, py)
+    return x_lo, y_lo, x_hi, y_hi
+
+
+def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
+               const double[::1] ranges, double range_min, double range_max,
+               const double[:, ::1] movers, double ox, double oy, double resolution,
+               Py_ssize_t ny, unsigned char[::1] returned, double stamp, double confirm,
+               double[::1] seen, unsigned char[::1] occupied, double[::1] hit_since,
+               unsigned char[::1] walls):
+    """One scan from (x, y) into the flat grids (``ny`` cells a column), as
+    ``Costmap.update`` defines it. Beam b points along ``(ux[b], uy[b])``; a range in
+    [range_min, range_max) is a return, at ``(x, y) + range * (ux, uy)``.
+
+    1. The cells of the returns, except those within ``resolution`` of a mover disc
+       (rows ``(x, y, radius)`` of ``movers``: ``hypot`` to its centre minus its
+       radius) or outside the grid, are the marks; ``returned`` (all 0, one byte a
+       cell) flags them meanwhile and is all 0 again on return.
+    2. Clearing: every point ``s = 0, step, 2 step, ...`` (``step`` half a cell) along
+       each beam up to its reach (half a cell short of its return, never beyond
+       ``range_max``) makes its cell seen at ``stamp``, free, and no wall, unless a
+       mark falls in it.
+    3. Marking: each marked cell is seen at ``stamp`` and occupied (its occupied spell
+       starting now, ``hit_since``, unless it was occupied already), and a wall once
+       that spell has lasted ``confirm`` seconds.
+
+    A cell is found with the arithmetic of ``Costmap.cell_of`` (``cell_index``).
+    """
+    cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t nx = seen.shape[0] // ny
-    cdef Py_ssize_t b, k, ix, iy, cell
-    cdef double s
-    for b in range(ux.shape[0]):
+    cdef Py_ssize_t b, k, m, ix, iy, cell, count = 0
+    cdef double step = resolution / 2
+    cdef double rho, reach, px, py, s, bx, by
+    cdef bint clear_of_movers
+    marks = np.empty(n, dtype=np.intp)
+    cdef Py_ssize_t[::1] marked = marks
+    for b in range(n):
+        rho = ranges[b]
+        if not (rho < range_max and rho >= range_min):
+            continue
+        px = x + rho * ux[b]
+        py = y + rho * uy[b]
+        clear_of_movers = True
+        for m in range(movers.shape[0]):
+            if not hypot(px - movers[m, 0], py - movers[m, 1]) - movers[m, 2] > resolution:
+                clear_of_movers = False
+                break
+        if not clear_of_movers:
+            continue
+        ix = cell_index(px - ox, resolution)
+        iy = cell_index(py - oy, resolution)
+        if not ((<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny)):
+            continue
+        cell = ix * ny + iy
+        marked[count] = cell
+        count += 1
+        returned[cell] = 1
+    for b in range(n):
+        rho = ranges[b]
+        reach = rho - step if rho < range_max and rho >= range_min else rho
+        if reach > range_max:  # (a nan stays nan: no point along that beam)
+            reach = range_max
+        bx, by = ux[b], uy[b]
         k = 0
-        while k * step <= reach[b]:
+        while k * step <= reach:
             s = k * step
             k += 1
-            ix = <Py_ssize_t>floor((ux[b] * s + x - ox) / resolution)
-            iy = <Py_ssize_t>floor((uy[b] * s + y - oy) / resolution)
-            if ix < 0 or ix >= nx or iy < 0 or iy >= ny:
-                continue
-            cell = ix * ny + iy
-            if returned[cell]:
-                continue
-            seen[cell] = stamp
-            occupied[cell] = 0
-            walls[cell] = 0
+            ix = cell_index(bx * s + x - ox, resolution)
+            iy = cell_index(by * s + y - oy, resolution)
+            # (0 <= ix < nx and 0 <= iy < ny, as one test)
+            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+                cell = ix * ny + iy
+                if not returned[cell]:
+                    seen[cell] = stamp
+                    occupied[cell] = 0
+                    walls[cell] = 0
+    for m in range(count):
+        returned[marked[m]] = 0
+    for m in range(count):
+        cell = marked[m]
+        if not occupied[cell]:
+            hit_since[cell] = stamp
+        seen[cell] = stamp
+        occupied[cell] = 1
+        if hit_since[cell] <= stamp - confirm:
+            walls[cell] = 1
+
+
+def look_up(const double[:, ::1] points, double ox, double oy, double resolution,
+            const unsigned char[::1] grid, Py_ssize_t ny, unsigned char outside,
+            unsigned char[::1] out):
+    """For each point (x, y), the flag of the cell it falls in (``Costmap.cell_of``'s
+    arithmetic) in the flat grid (``ny`` cells a column), or ``outside`` beyond it."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, ix, iy
+    for i in range(points.shape[0]):
+        ix = cell_index(points[i, 0] - ox, resolution)
+        iy = cell_index(points[i, 1] - oy, resolution)
+        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+            out[i] = grid[ix * ny + iy]
+        else:
+            out[i] = outside
+
+
+def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
+                const long[::1] di, const long[::1] dj, unsigned char[::1] out):
+    """Flag in ``out`` (the flat grid, ``ny`` cells a column) every cell within the
+    grid at an offset ``(di[k], dj[k])`` from one of the ``centres`` (flat indices)."""
+    cdef Py_ssize_t c, k, i, j, a, b
+    for c in range(centres.shape[0]):
+        i = centres[c] // ny
+        j = centres[c] % ny
+        for k in range(di.shape[0]):
+            a = i + di[k]
+            b = j + dj[k]
+            if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
+                out[a * ny + b] = 1
 
 
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,

@@ -16,8 +16,9 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   not the space beyond the grid: the global path never leaves it (the grid holds start,
   goal, the robot and every return with half the padding to spare; only ``max_size``
   can leave one out);
-- occupied cells are inflated by the robot radius plus a margin with a Euclidean distance
-  transform (scipy.ndimage), so a path through the free cells keeps the robot's disc
+- occupied cells are inflated by the robot radius plus a margin (each occupied cell's
+  disc of cells stamped, or with many of them scipy.ndimage's Euclidean distance
+  transform: the same cells), so a path through the free cells keeps the robot's disc
   clear of everything the map holds;
 - apart from the map the path is planned on, a wall memory keeps every confirmed
   obstacle cell until a beam passes through it (no decay, no recovery clearing):
@@ -43,7 +44,12 @@ import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import clear_beams
+from zenav.services.planner._loops import (
+    look_up,
+    return_bounds,
+    stamp_discs,
+    trace_scan,
+)
 
 Vec = npt.NDArray[np.float64]
 BoolGrid = npt.NDArray[np.bool_]
@@ -72,6 +78,19 @@ def _flat(grid: npt.NDArray[G]) -> npt.NDArray[G]:
     flat = grid.reshape(-1)
     assert flat.base is grid or flat.base is grid.base
     return flat
+
+
+def _disc_offsets(resolution: float, inflation: float) -> tuple[npt.NDArray[np.int_],
+                                                               npt.NDArray[np.int_]]:
+    """The cell offsets (di, dj) whose centres lie within ``inflation`` of a cell's, as
+    the distance transform's test has it: ``sqrt(di^2 + dj^2) * resolution <=
+    inflation`` in doubles (the offsets inflation blocks round a lethal cell)."""
+    reach = math.ceil(max(inflation, 0.0) / resolution) + 1
+    pairs = [(di, dj) for di in range(-reach, reach + 1) for dj in range(-reach, reach + 1)
+             if math.sqrt(float(di * di + dj * dj)) * resolution <= inflation]
+    di = np.array([p[0] for p in pairs], dtype=np.int_)
+    dj = np.array([p[1] for p in pairs], dtype=np.int_)
+    return di, dj
 
 
 class Costmap:
@@ -108,8 +127,9 @@ class Costmap:
         self.version = 0  # bumped whenever the grids change
         self._refreshed: tuple[int, float] | None = None  # (version, now) of the cache
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
-        self._gap: npt.NDArray[np.float64] | None = None
-        self._returned = np.zeros(0, dtype=bool)  # per flat cell: a return of this scan
+        self._gap: npt.NDArray[np.float64] | None = None  # of _inflated's lethal cells
+        self._disc = _disc_offsets(resolution, inflation)
+        self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -136,14 +156,22 @@ class Costmap:
         blocks of ``padding``), never beyond ``max_size`` a side."""
         if len(points) == 0:
             return
+        lo = np.min(points, axis=0)
+        hi = np.max(points, axis=0)
+        self._grow_to_box(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), margin)
+
+    def _grow_to_box(self, x_lo: float, y_lo: float, x_hi: float, y_hi: float,
+                     margin: float) -> None:
+        """``grow_to`` the points of the box [x_lo, x_hi] x [y_lo, y_hi]."""
         r = self.resolution
         nx, ny = self.shape
-        lo = np.min(points, axis=0) - margin
-        hi = np.max(points, axis=0) + margin
-        top = self.origin + np.array([nx, ny]) * r
-        if (self.origin[0] <= lo[0] and self.origin[1] <= lo[1] and hi[0] <= top[0]
-                and hi[1] <= top[1]):
+        ox, oy = float(self.origin[0]), float(self.origin[1])
+        if (ox <= x_lo - margin and oy <= y_lo - margin and x_hi + margin <= ox + nx * r
+                and y_hi + margin <= oy + ny * r):
             return  # inside already (what the growth below would find, cheaper)
+        lo = np.array([x_lo, y_lo]) - margin
+        hi = np.array([x_hi, y_hi]) + margin
+        top = self.origin + np.array([nx, ny]) * r
         add_lo = np.maximum(np.ceil((self.origin - lo) / self.padding), 0) * self.padding
         add_hi = np.maximum(np.ceil((hi - top) / self.padding), 0) * self.padding
         if not (add_lo.any() or add_hi.any()):
@@ -176,49 +204,33 @@ class Costmap:
         tracks typed dynamic; returns inside them are not marked."""
         self.now = max(self.now, stamp)
         x, y, heading = scan.pose
-        ranges = np.asarray(scan.ranges, dtype=np.float64)
+        ranges = np.ascontiguousarray(scan.ranges, dtype=np.float64)
         alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
-        hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
-        ends = np.column_stack(to_global(scan.pose, ranges, alpha))  # Eq. 1
-        # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the robot).
+        # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
+        # robot); a return lies at the robot plus its range times that (Eq. 1 again).
         ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
-        self.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
-                     self.padding / 2)
-        # Hits, except those on a mover.
-        marks = ends[hit]
-        if movers and len(marks):
-            discs = np.asarray(movers, dtype=np.float64).reshape(-1, 3)
-            gap = np.hypot(marks[:, None, 0] - discs[None, :, 0],
-                           marks[:, None, 1] - discs[None, :, 1]) - discs[None, :, 2]
-            marks = marks[(gap > self.resolution).all(axis=1)]
-        hits = self.cell_of(marks)
-        hits = hits[self.inside(hits)]
+        ux, uy = np.ascontiguousarray(ux), np.ascontiguousarray(uy)
+        box = return_bounds(x, y, ux, uy, ranges, scan.range_min, scan.range_max)
+        self._grow_to_box(*box, self.padding / 2)
         nx, ny = self.shape
-        # Free space: every half cell along each beam, stopping half a cell short of
-        # its return (a beam with no return clears up to its reach), in compiled code
-        # (``_loops.clear_beams``).
-        # A cell a return of this scan falls in is not cleared by this scan: along a
-        # straight wall, the beams that meet it at a grazing angle pass through the face
-        # cells the others return from, and clearing them would restart their
-        # confirmation on every scan (a wall seen side-on would never be confirmed).
-        step = self.resolution / 2
-        # (never beyond the laser's reach: a range above it must not make a beam endless)
-        reach = np.minimum(np.where(hit, ranges - step, ranges), scan.range_max)
         if self._returned.size != nx * ny:
-            self._returned = np.zeros(nx * ny, dtype=bool)
-        hit_flat = hits[:, 0] * ny + hits[:, 1]
-        self._returned[hit_flat] = True
-        clear_beams(x, y, np.ascontiguousarray(ux), np.ascontiguousarray(uy), reach, step,
-                    float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
-                    self._returned.view(np.uint8), stamp, _flat(self.seen),
-                    _flat(self.occupied).view(np.uint8), _flat(self.walls).view(np.uint8))
-        self._returned[hit_flat] = False  # all False again for the next scan
-        newly = ~self.occupied[hits[:, 0], hits[:, 1]]
-        self.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
-        self.seen[hits[:, 0], hits[:, 1]] = stamp
-        self.occupied[hits[:, 0], hits[:, 1]] = True
-        confirmed = self.hit_since[hits[:, 0], hits[:, 1]] <= stamp - self.confirm
-        self.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
+            self._returned = np.zeros(nx * ny, dtype=np.uint8)
+        discs = np.asarray(movers if movers else [], dtype=np.float64).reshape(-1, 3)
+        # Compiled (``_loops.trace_scan``), in three steps:
+        # - the marks: the cells of the returns, except those on a mover;
+        # - free space: every half cell along each beam, stopping half a cell short of
+        #   its return (a beam with no return clears up to its reach, never beyond the
+        #   laser's: a range above it must not make a beam endless), except the marked
+        #   cells: along a straight wall, the beams that meet it at a grazing angle pass
+        #   through the face cells the others return from, and clearing them would
+        #   restart their confirmation on every scan (a wall seen side-on would never be
+        #   confirmed);
+        # - the marking: occupied now, a wall once occupied for ``confirm`` seconds.
+        trace_scan(x, y, ux, uy, ranges, scan.range_min, scan.range_max, discs,
+                   float(self.origin[0]), float(self.origin[1]), self.resolution, ny,
+                   self._returned, stamp, self.confirm, _flat(self.seen),
+                   _flat(self.occupied).view(np.uint8), _flat(self.hit_since),
+                   _flat(self.walls).view(np.uint8))
         self.version += 1
 
     def forget_older_than(self, stamp: float, keep: tuple[Vec, float] | None = None) -> None:
@@ -255,8 +267,7 @@ class Costmap:
             return False  # beyond the grid: no knowledge, no verdict
         if not self.walls.any():
             return False
-        gap = np.asarray(distance_transform_edt(~self.walls), dtype=np.float64)
-        free = gap * self.resolution > clearance
+        free = self._distances(self.walls) > clearance
         labels, _ = label(free)
         reach = math.ceil(clearance / self.resolution) + 1
 
@@ -266,6 +277,11 @@ class Costmap:
             return set(np.unique(window[window > 0]).tolist())
 
         return not near(ends[0]) & near(ends[1])
+
+    def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
+        """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
+        one), m: scipy's Euclidean distance transform."""
+        return np.asarray(distance_transform_edt(~cells), dtype=np.float64) * self.resolution
 
     def known(self) -> BoolGrid:
         return np.asarray(self.seen >= self.now - self.decay)
@@ -287,14 +303,19 @@ class Costmap:
         # update bumps the version, though the set mostly stays the same).
         if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
             return self._inflated
-        if lethal.any():
-            gap = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * self.resolution
-            blocked = np.asarray(gap <= self.inflation)
-        else:
-            gap = np.full(lethal.shape, math.inf)
+        # The blocked cells are those within the inflation distance of a lethal one;
+        # the distances themselves (``gap``) only when asked: most cycles need none.
+        # Few lethal cells: each one's disc of blocked cells; many: the distances.
+        centres = np.flatnonzero(lethal)
+        di, dj = self._disc
+        if len(centres) * len(di) <= 4 * lethal.size:
             blocked = np.zeros_like(lethal)
+            stamp_discs(centres, *self.shape, di, dj, _flat(blocked).view(np.uint8))
+            self._gap = None
+        else:
+            self._gap = self._distances(lethal)
+            blocked = np.asarray(self._gap <= self.inflation)
         self._inflated = (lethal, blocked)
-        self._gap = gap
         return lethal, blocked
 
     def lethal_grid(self) -> BoolGrid:
@@ -309,27 +330,28 @@ class Costmap:
     def gap(self) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest occupied one, m (inf
         when none is known)."""
-        self._refresh()
-        assert self._gap is not None
+        lethal = self._refresh()[0]
+        if self._gap is None:
+            self._gap = (self._distances(lethal) if lethal.any()
+                         else np.full(lethal.shape, math.inf))
         return self._gap
 
     def blocked_at(self, points: Vec, *, outside: bool = False) -> npt.NDArray[np.bool_]:
         """Whether each point (n, 2) lies in a blocked cell; a point beyond the grid is
         ``outside`` (free by default: the local checks near the robot, which the grid
         always holds with room to spare; the global path passes True)."""
-        cells = self.cell_of(points)
-        ok = self.inside(cells)
-        out = np.full(len(cells), outside, dtype=bool)
-        grid = self.blocked()
-        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
-        return out
+        return self._look_up(points, self.blocked(), outside)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
-        cells = self.cell_of(points)
-        ok = self.inside(cells)
-        out = np.zeros(len(cells), dtype=bool)
-        grid = self._refresh()[0]
-        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return self._look_up(points, self._refresh()[0], False)
+
+    def _look_up(self, points: Vec, grid: BoolGrid, outside: bool) -> npt.NDArray[np.bool_]:
+        """The flag of the cell of each point (n, 2) in ``grid`` (``cell_of``), or
+        ``outside`` beyond the grid, in compiled code (``_loops.look_up``)."""
+        xy = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        out = np.empty(len(xy), dtype=bool)
+        look_up(xy, float(self.origin[0]), float(self.origin[1]), self.resolution,
+                _flat(grid).view(np.uint8), self.shape[1], outside, out.view(np.uint8))
         return out
 
     def values(self) -> npt.NDArray[np.int8]:

@@ -176,6 +176,67 @@ class _Measurement:
     n_parts: int
 
 
+@dataclass(frozen=True, slots=True)
+class _Rows:
+    """The per-cluster values of a chain the tracker reads one by one, as Python numbers
+    (``tolist``: the same values; a numpy scalar costs more to index and convert than
+    the arithmetic done with it on a chain of a few obstacles)."""
+
+    centre: list[tuple[float, float]]
+    chord_centre: list[tuple[float, float]]
+    radius: list[float]
+    box: list[tuple[int, int, int, int]]
+    area: list[int]
+    edge_start: list[int]
+    edge_end: list[int]
+    mean_rho: list[float]
+    beams: list[list[int]]
+    first_point: list[list[float]]
+    last_point: list[list[float]]
+    moved: list[float] | None
+    moved_each: list[list[float]] | None
+    moved_refs: list[float] | None
+
+    @staticmethod
+    def of(clusters: Clusters) -> _Rows:
+        each, refs = clusters.moved_each, clusters.moved_refs
+        return _Rows(
+            centre=[(x, y) for x, y in clusters.centre.tolist()],
+            chord_centre=[(x, y) for x, y in clusters.chord_centre.tolist()],
+            radius=clusters.radius.tolist(),
+            box=[(a, b, c, d) for a, b, c, d in clusters.box.tolist()],
+            area=clusters.area.tolist(),
+            edge_start=clusters.edge_start.tolist(),
+            edge_end=clusters.edge_end.tolist(),
+            mean_rho=clusters.mean_rho.tolist(),
+            beams=clusters.beams.tolist(),
+            first_point=clusters.first_point.tolist(),
+            last_point=clusters.last_point.tolist(),
+            moved=clusters.moved.tolist() if clusters.moved is not None else None,
+            moved_each=each.tolist() if each is not None and refs is not None else None,
+            moved_refs=refs.tolist() if each is not None and refs is not None else None,
+        )  # fmt: skip
+
+
+def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
+    """Cluster ``c``'s motion score against the earlier scans taken since the track was
+    first seen (``born``). An obstacle that appears out of nothing occupies space the
+    scans before it saw empty, without having moved: the paper calls it new, and it is
+    judged from its own next scans, not from the empty space before. (The largest score
+    as numpy's ``max(initial=0.0)`` has it: nan if any is.)
+    """
+    if rows.moved_each is None or rows.moved_refs is None:
+        return rows.moved[c] if rows.moved is not None else 0.0
+    limit = born - 1e-9
+    best = 0.0
+    for ref, score in zip(rows.moved_refs, rows.moved_each[c], strict=True):
+        if math.isfinite(ref) and ref >= limit:
+            if math.isnan(score):
+                return math.nan
+            best = score if score > best else best
+    return best
+
+
 def _union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
     """The grid box holding both boxes (ix_min, ix_max, iy_min, iy_max)."""
     return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
@@ -221,10 +282,13 @@ class Tracker:
         for t in self._tracks:
             self._predict(t, dt)
 
-        points = clusters.chord_centre if smoothed and p.position == "chord" else clusters.centre
+        use_chord = smoothed and p.position == "chord"
+        points = clusters.chord_centre if use_chord else clusters.centre
+        rows = _Rows.of(clusters)
         owner = self._associate(points, clusters)
-        groups = self._join_pieces(owner, points, clusters)
-        meas = {ti: self._measure(cl, clusters, pose, smoothed) for ti, cl in groups.items()}
+        groups = self._join_pieces(owner, rows, rows.chord_centre if use_chord else rows.centre)
+        meas = {ti: self._measure(cl, clusters, pose, smoothed, rows)
+                for ti, cl in groups.items()}
         hold, coast = self._merges(meas, prev_stamp, stamp)
 
         claimed = {c for cl in groups.values() for c in cl}
@@ -232,7 +296,7 @@ class Tracker:
         fresh: set[int] = set()
         for c in range(len(clusters)):
             if c not in claimed:  # a new obstacle: a new track, ids in scan order
-                m = self._measure([c], clusters, pose, smoothed)
+                m = self._measure([c], clusters, pose, smoothed, rows)
                 fresh.add(len(self._tracks))
                 members[len(self._tracks)] = [c]
                 meas[len(self._tracks)] = m
@@ -248,20 +312,22 @@ class Tracker:
             cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
         )  # fmt: skip
         best = best_match(corr)
+        best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
+        best_delta, best_index = best.delta.tolist(), best.index.tolist()
 
         for row, ti in enumerate(order):
             t = self._tracks[ti]
             m = meas[ti]
-            t.xi = float(best.xi[row])
-            t.varsigma = float(best.varsigma_max[row])
-            t.delta = float(best.delta[row])
+            t.xi = best_xi[row]
+            t.varsigma = best_varsigma[row]
+            t.delta = best_delta[row]
             if ti not in fresh:
                 t.age += 1
                 if ti not in coast:
                     self._correct(t, m)
             was_static = t.kind == "static"
             if clusters.moved is not None:
-                moved = max(self._moved_since_born(clusters, c, t.born) for c in members[ti])
+                moved = max(_moved_since_born(rows, c, t.born) for c in members[ti])
                 if moved >= p.moved_threshold:
                     t.last_moved = stamp
             if smoothed:
@@ -272,7 +338,7 @@ class Tracker:
                     theta_varsigma1=p.theta_varsigma1, theta_varsigma2=p.theta_varsigma2,
                     theta_delta=p.theta_delta, theta_xi=p.theta_xi,
                 )  # fmt: skip
-                j = int(best.index[row])
+                j = best_index[row]
                 if j >= 0:  # Eq. 15 between this frame and the chain compared with
                     before = (float(ref_centres[j, 0]), float(ref_centres[j, 1]))
                     mo = motion(m.centre, before, stamp - ref_stamp)
@@ -287,7 +353,7 @@ class Tracker:
                 # in front or by the window edge neither grows nor shrinks it.
                 if not m.partial:
                     t.box = _union(t.box, m.box)
-                    t.area = int(box_area(np.array(t.box)))
+                    t.area = int(box_area(t.box))
                     t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
@@ -347,13 +413,14 @@ class Tracker:
         dist = np.sqrt(dx * dx + dy * dy)
         cost = np.where(dist <= gate[None, :], dist, _NO_MATCH)
         rows, cols = linear_sum_assignment(cost)
-        for r, c in zip(rows.tolist(), cols.tolist(), strict=True):
-            if cost[r, c] < _NO_MATCH:
+        matched = (cost[rows, cols] < _NO_MATCH).tolist()
+        for r, c, ok in zip(rows.tolist(), cols.tolist(), matched, strict=True):
+            if ok:
                 owner[r] = c
         return owner
 
     def _join_pieces(
-        self, owner: list[int], points: FloatArray, clusters: Clusters
+        self, owner: list[int], rows: _Rows, points: list[tuple[float, float]]
     ) -> dict[int, list[int]]:
         """Track -> its clusters: the assigned one plus the pieces of the same obstacle.
 
@@ -365,24 +432,26 @@ class Tracker:
           each other are both occluded.
         """
         groups: dict[int, list[int]] = {ti: [c] for c, ti in enumerate(owner) if ti >= 0}
-        n = len(clusters)
-        rho = clusters.mean_rho
+        n = len(owner)
+        if all(ti >= 0 for ti in owner):
+            return groups  # nothing left over to join
+        rho = rows.mean_rho
         for c in range(n):
             if owner[c] >= 0:
                 continue
-            j = self._adjacent_piece(c, owner, clusters)
+            j = self._adjacent_piece(c, owner, rows)
             if j >= 0 and self._in_gate(points[c], owner[j]):
                 groups[owner[j]].append(c)
                 continue
             for step in (-1, 1):
-                own_end = clusters.edge_start if step < 0 else clusters.edge_end
-                far_end = clusters.edge_end if step < 0 else clusters.edge_start
+                own_end = rows.edge_start if step < 0 else rows.edge_end
+                far_end = rows.edge_end if step < 0 else rows.edge_start
                 if own_end[c] != EDGE_OCCLUDED:
                     continue
                 j = c + step
                 nearest_between = math.inf
                 while 0 <= j < n and rho[j] < rho[c]:
-                    nearest_between = min(nearest_between, float(rho[j]))
+                    nearest_between = min(nearest_between, rho[j])
                     j += step
                 if not (0 <= j < n) or j == c + step or owner[j] < 0:
                     continue
@@ -396,11 +465,11 @@ class Tracker:
             cl.sort()
         return groups
 
-    def _in_gate(self, point: FloatArray, ti: int) -> bool:
+    def _in_gate(self, point: tuple[float, float], ti: int) -> bool:
         t = self._tracks[ti]
         return math.hypot(point[0] - t.x, point[1] - t.y) <= t.radius + self.params.gate
 
-    def _adjacent_piece(self, c: int, owner: list[int], clusters: Clusters) -> int:
+    def _adjacent_piece(self, c: int, owner: list[int], rows: _Rows) -> int:
         """The associated cluster that c is a chip of (next in the scan, ends close), or -1.
 
         A surface seen at a grazing angle, with range noise, breaks off a few beams at its
@@ -409,12 +478,12 @@ class Tracker:
         """
         gap = self.params.piece_gap
         for j in (c - 1, c + 1):
-            if not 0 <= j < len(clusters) or owner[j] < 0:
+            if not 0 <= j < len(owner) or owner[j] < 0:
                 continue
             a, b = (j, c) if j < c else (c, j)  # a before b in the scan
-            if clusters.beams[b, 0] - clusters.beams[a, 1] > _PIECE_BEAMS:
+            if rows.beams[b][0] - rows.beams[a][1] > _PIECE_BEAMS:
                 continue
-            end, start = clusters.last_point[a], clusters.first_point[b]
+            end, start = rows.last_point[a], rows.first_point[b]
             if math.hypot(end[0] - start[0], end[1] - start[1]) <= gap:
                 return j
         return -1
@@ -458,25 +527,23 @@ class Tracker:
     # --- measurements and the chain history -------------------------------------------
 
     def _measure(
-        self, cl: list[int], clusters: Clusters, pose: Pose, smoothed: bool
+        self, cl: list[int], clusters: Clusters, pose: Pose, smoothed: bool,
+        rows: _Rows | None = None,
     ) -> _Measurement:
-        """The measurement of one obstacle from its cluster(s), pieces joined in scan order."""
+        """The measurement of one obstacle from its cluster(s), pieces joined in scan order
+        (``rows``: the chain's, when the caller has them already)."""
         use_chord = smoothed and self.params.position == "chord"
         if len(cl) == 1:
             c = cl[0]
-            centre = (float(clusters.centre[c, 0]), float(clusters.centre[c, 1]))
-            b = clusters.box[c]
-            box = (int(b[0]), int(b[1]), int(b[2]), int(b[3]))
-            chord = (float(clusters.chord_centre[c, 0]), float(clusters.chord_centre[c, 1]))
+            r = rows if rows is not None else _Rows.of(clusters)
+            centre = r.centre[c]
             return _Measurement(
                 centre=centre,
-                point=chord if use_chord else centre,
-                radius=float(clusters.radius[c]),
-                box=box,
-                area=int(clusters.area[c]),
-                partial=bool(
-                    clusters.edge_start[c] != EDGE_FREE or clusters.edge_end[c] != EDGE_FREE
-                ),
+                point=r.chord_centre[c] if use_chord else centre,
+                radius=r.radius[c],
+                box=r.box[c],
+                area=r.area[c],
+                partial=r.edge_start[c] != EDGE_FREE or r.edge_end[c] != EDGE_FREE,
                 n_parts=1,
             )
         idx = np.asarray(cl, dtype=np.int64)
@@ -581,18 +648,6 @@ class Tracker:
         t.p00 = (1.0 - k0) * p00
         t.p01 = (1.0 - k0) * p01
         t.p11 = p11 - k1 * p01
-
-    @staticmethod
-    def _moved_since_born(clusters: Clusters, c: int, born: float) -> float:
-        """Cluster ``c``'s motion score against the earlier scans taken since the track
-        was first seen (``born``). An obstacle that appears out of nothing occupies
-        space the scans before it saw empty, without having moved: the paper calls it
-        new, and it is judged from its own next scans, not from the empty space before.
-        """
-        if clusters.moved_each is None or clusters.moved_refs is None:
-            return float(clusters.moved[c]) if clusters.moved is not None else 0.0
-        since = np.isfinite(clusters.moved_refs) & (clusters.moved_refs >= born - 1e-9)
-        return float(clusters.moved_each[c][since].max(initial=0.0))
 
     def _smoothed_kind(self, t: _State, stamp: float, cue: bool) -> Kind:
         """Type from the free-space motion cue when perception measures it, else from the

@@ -140,7 +140,8 @@ def test_eq1_is_what_the_map_calls(monkeypatch: pytest.MonkeyPatch) -> None:
     cm = costmap.Costmap((0.0, 0.0), (6.0, 0.0), resolution=0.1, decay=60.0, inflation=0.35,
                          confirm=0.0, padding=2.0, max_size=100.0)
     cm.update(scan_of((0.0, 0.0, 0.0), boxes=[(3.0, -1.0, 3.2, 1.0)]), 0.0)
-    assert spy.calls == 2  # the returns, and each beam's direction
+    # each beam's direction, once; a return lies at its range along that direction
+    assert spy.calls == 1
     i, j = cm.cell_of(np.array([[3.05, 0.0]]))[0]
     assert int(cm.values()[i, j]) == costmap.OCCUPIED
 

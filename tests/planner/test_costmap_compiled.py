@@ -1,0 +1,211 @@
+"""The map's compiled scan tracing (``_loops.trace_scan``, what ``Costmap.update`` calls)
+gives, to the bit, the grids of the numpy update it replaced: the marks (Eq. 1 returns,
+those on a mover left out), the ray tracing and the marking with its confirmation."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from scipy.ndimage import distance_transform_edt
+
+from zenav.services.perception.clustering import to_global
+from zenav.services.planner._loops import floor_quotients
+from zenav.services.planner.costmap import Costmap, ScanData
+
+Mover = tuple[float, float, float]
+
+
+def numpy_update(cm: Costmap, scan: ScanData, stamp: float,
+                 movers: list[Mover] | None = None) -> None:
+    """The update as numpy array operations (the code ``trace_scan`` replaced)."""
+    cm.now = max(cm.now, stamp)
+    x, y, heading = scan.pose
+    ranges = np.asarray(scan.ranges, dtype=np.float64)
+    alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+    hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
+    ends = np.column_stack(to_global(scan.pose, ranges, alpha))
+    ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
+    cm.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
+               cm.padding / 2)
+    marks = ends[hit]
+    if movers and len(marks):
+        discs = np.asarray(movers, dtype=np.float64).reshape(-1, 3)
+        gap = np.hypot(marks[:, None, 0] - discs[None, :, 0],
+                       marks[:, None, 1] - discs[None, :, 1]) - discs[None, :, 2]
+        marks = marks[(gap > cm.resolution).all(axis=1)]
+    hits = cm.cell_of(marks)
+    hits = hits[cm.inside(hits)]
+    returned = np.zeros(cm.shape, dtype=bool)
+    returned[hits[:, 0], hits[:, 1]] = True
+    step = cm.resolution / 2
+    reach = np.minimum(np.where(hit, ranges - step, ranges), scan.range_max)
+    count = int(np.nanmax(reach / step, initial=0.0)) + 2
+    s = np.arange(count) * step
+    along = s[None, :] <= reach[:, None]
+    px = ux[:, None] * s[None, :] + x
+    py = uy[:, None] * s[None, :] + y
+    cells = cm.cell_of(np.column_stack([px[along], py[along]]))
+    cells = cells[cm.inside(cells)]
+    cells = cells[~returned[cells[:, 0], cells[:, 1]]]
+    cm.seen[cells[:, 0], cells[:, 1]] = stamp
+    cm.occupied[cells[:, 0], cells[:, 1]] = False
+    cm.walls[cells[:, 0], cells[:, 1]] = False
+    newly = ~cm.occupied[hits[:, 0], hits[:, 1]]
+    cm.hit_since[hits[newly, 0], hits[newly, 1]] = stamp
+    cm.seen[hits[:, 0], hits[:, 1]] = stamp
+    cm.occupied[hits[:, 0], hits[:, 1]] = True
+    confirmed = cm.hit_since[hits[:, 0], hits[:, 1]] <= stamp - cm.confirm
+    cm.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
+    cm.version += 1
+
+
+def same_grids(a: Costmap, b: Costmap) -> bool:
+    return (a.origin.tobytes() == b.origin.tobytes() and a.version == b.version
+            and all(getattr(a, g).tobytes() == getattr(b, g).tobytes()
+                    for g in ("seen", "occupied", "hit_since", "walls")))
+
+
+def scans(rng: np.random.Generator, aligned: bool) -> list[tuple[ScanData, list[Mover]]]:
+    """A robot wandering among returns near and far, some beams with none, some ranges
+    below range_min; ``aligned`` puts it on cell corners and the beams along the axes
+    (quotients that are whole numbers: the exact edges of the floor)."""
+    out = []
+    for _ in range(8):
+        if aligned:
+            pose = (float(rng.integers(20, 90)) / 10, float(rng.integers(20, 90)) / 10,
+                    float(rng.integers(-4, 4)) * math.pi / 2)
+            beams, start, inc = 361, -math.pi, math.pi / 180
+        else:
+            pose = (float(rng.uniform(2, 9)), float(rng.uniform(2, 9)),
+                    float(rng.uniform(-3, 3)))
+            beams, start, inc = 181, -math.pi / 2, math.pi / 180
+        ranges = np.round(rng.uniform(0.0, 9.0, beams), 1 if aligned else 8)
+        ranges[rng.random(beams) < 0.3] = 8.0  # no return
+        ranges = np.minimum(ranges, 8.0)
+        movers = [(pose[0] + float(rng.uniform(-3, 3)), pose[1] + float(rng.uniform(-3, 3)),
+                   float(rng.uniform(0.1, 0.6))) for _ in range(int(rng.integers(0, 4)))]
+        out.append((ScanData(pose, ranges, start, inc, 8.0, range_min=0.1), movers))
+    return out
+
+
+@pytest.mark.parametrize("aligned", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_the_compiled_update_gives_the_grids_of_the_numpy_one(seed: int,
+                                                              aligned: bool) -> None:
+    rng = np.random.default_rng(seed)
+    compiled = Costmap((4.0, 4.0), (6.0, 6.0), resolution=0.1, decay=60.0, inflation=0.3,
+                       confirm=0.25, padding=1.0, max_size=30.0)
+    reference = copy.deepcopy(compiled)
+    marked_on_movers = 0
+    unconfirmed = False
+    # each scan three times over (0.3 s > confirm: its returns become walls)
+    for k, (scan, movers) in enumerate(s for s in scans(rng, aligned) for _ in range(3)):
+        stamp = 0.15 * k
+        compiled.update(scan, stamp, movers)
+        numpy_update(reference, scan, stamp, movers)
+        assert same_grids(compiled, reference)
+        marked_on_movers += len(movers)
+        unconfirmed |= bool((compiled.occupied & ~compiled.walls).any())
+    assert marked_on_movers  # the mover test ran
+    assert unconfirmed and compiled.walls.any()  # marks before and after confirmation
+
+
+def test_a_scan_with_no_return_and_one_with_nan_ranges_trace_alike() -> None:
+    compiled = Costmap((0.0, 0.0), (3.0, 0.0), resolution=0.1, decay=60.0, inflation=0.3,
+                       confirm=0.0, padding=1.0, max_size=30.0)
+    reference = copy.deepcopy(compiled)
+    ranges = np.full(91, 8.0)
+    ranges[10:20] = np.nan  # no return, and no point along the beam either
+    ranges[40:50] = 1.5
+    for stamp, r in ((0.0, np.full(91, 8.0)), (0.1, ranges)):
+        scan = ScanData((0.0, 0.0, 0.3), r, -0.5, 0.01, 8.0)
+        compiled.update(scan, stamp, [(1.0, 0.0, 0.2)])
+        numpy_update(reference, scan, stamp, [(1.0, 0.0, 0.2)])
+        assert same_grids(compiled, reference)
+
+
+def test_the_cell_index_is_the_floor_of_the_quotient() -> None:
+    """``cell_index`` (truncation, one less below zero with a fraction) against
+    ``np.floor(offset / resolution)``: whole quotients, their neighbours a unit of the
+    last place away, signed zeros, and random offsets."""
+    resolution = 0.1
+    whole = np.arange(-300, 300) * resolution
+    offsets = np.concatenate([
+        whole, np.nextafter(whole, -np.inf), np.nextafter(whole, np.inf),
+        [0.0, -0.0, 1e-300, -1e-300, 5e-324, -5e-324, 1e12, -1e12],
+        np.random.default_rng(0).uniform(-50.0, 50.0, 5000)])
+    out = np.empty(offsets.size, dtype=np.int_)
+    floor_quotients(offsets, resolution, out)
+    assert np.array_equal(out, np.floor(offsets / resolution).astype(np.int64))
+
+
+def test_the_map_looks_points_up_as_cell_of_and_inside_do() -> None:
+    """``blocked_at`` and ``lethal_at`` (compiled ``look_up``) against the numpy look-up
+    they replaced: points inside and beyond the grid, on cell edges, and nan."""
+    rng = np.random.default_rng(5)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
+                       math.pi / 180, 8.0), 0.0)
+    edges = np.column_stack([np.arange(-12, 52) * 0.1, np.arange(-12, 52)[::-1] * 0.1])
+    points = np.vstack([rng.uniform(-3.0, 8.0, (2000, 2)), edges,
+                        [[np.nan, 1.0], [1.0, np.nan], [np.inf, 0.0]]])
+
+    def numpy_look_up(grid: np.ndarray, outside: bool) -> np.ndarray:
+        with np.errstate(invalid="ignore"):
+            cells = cm.cell_of(points)
+        ok = cm.inside(cells)
+        out = np.full(len(cells), outside, dtype=bool)
+        out[ok] = grid[cells[ok, 0], cells[ok, 1]]
+        return out
+
+    for outside in (False, True):
+        blocked = cm.blocked_at(points, outside=outside)
+        assert np.array_equal(blocked, numpy_look_up(cm.blocked(), outside))
+    lethal = cm.lethal_at(points)
+    assert np.array_equal(lethal, numpy_look_up(cm.lethal_grid(), False))
+    assert lethal.any() and blocked.any() and not blocked.all()
+
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_maps_distances_and_blocked_cells_are_scipys(seed: int) -> None:
+    """``gap`` (asked after the stamping) and ``blocked`` on the map's own grid, against
+    ``scipy.ndimage.distance_transform_edt`` of its lethal cells."""
+    rng = np.random.default_rng(seed)
+    cm = Costmap((0.0, 0.0), (5.0, 4.0), resolution=0.05, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.4), rng.uniform(0.5, 5.0, 361), -math.pi, math.pi / 180,
+                       8.0), 0.0)
+    lethal = cm.lethal_grid()
+    assert lethal.any()
+    expected = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * cm.resolution
+    assert cm.gap().tobytes() == expected.tobytes()
+    assert np.array_equal(cm.blocked(), expected <= cm.inflation)
+
+
+@pytest.mark.parametrize("inflation", [0.0, 0.1, 0.3, 0.35, 0.45, 1.2])
+@pytest.mark.parametrize("many", [False, True])
+def test_the_blocked_cells_are_those_within_the_inflation_by_the_distance_transform(
+        inflation: float, many: bool) -> None:
+    """The blocked cells, stamped as discs round few lethal cells or read off the
+    distances when there are many, are the cells whose scipy distance times the
+    resolution is within the inflation (in doubles: at 0.3 m on a 0.1 m grid the cell
+    3 cells away is 0.30000000000000004 m off, not blocked)."""
+    rng = np.random.default_rng(int(inflation * 100) + many)
+    cm = Costmap((0.0, 0.0), (5.0, 4.0), resolution=0.1, decay=60.0, inflation=inflation,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    ranges = rng.uniform(0.3, 1.2 if many else 5.0, 721 if many else 61)
+    cm.update(ScanData((2.0, 2.0, 0.0), ranges, -math.pi, 2 * math.pi / (len(ranges) - 1),
+                       8.0), 0.0)
+    lethal = cm.lethal_grid()
+    di, _ = cm._disc
+    by_distances = np.count_nonzero(lethal) * len(di) > 4 * lethal.size
+    if not many or inflation > 1:
+        assert by_distances == many  # each way is taken
+    expected = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * 0.1
+    assert np.array_equal(cm.blocked(), expected <= inflation)
+    assert cm.gap().tobytes() == expected.tobytes()

@@ -1,0 +1,55 @@
+"""The tracker reads a chain's per-cluster values as Python numbers (``_Rows``); the
+motion score since a track's birth taken from them is numpy's masked maximum."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from zenav.services.perception.clustering import Clusters
+from zenav.services.tracking.tracker import _moved_since_born, _Rows
+
+
+def chain(each: np.ndarray, refs: np.ndarray) -> Clusters:
+    n = each.shape[0]
+    f1, f2, i1 = np.zeros(n), np.zeros((n, 2)), np.zeros(n, dtype=np.int64)
+    return Clusters(centre=f2, mean_rho=f1, mean_alpha=f1, box=np.zeros((n, 4), np.int64),
+                    area=i1, beams=np.zeros((n, 2), np.int64), n_beams=i1, first_point=f2,
+                    last_point=f2, chord_centre=f2, radius=f1, edge_start=i1, edge_end=i1,
+                    pose=(0.0, 0.0, 0.0), cell=0.5, moved=each.max(axis=1, initial=0.0),
+                    moved_each=each, moved_refs=refs)
+
+
+def numpy_score(clusters: Clusters, c: int, born: float) -> float:
+    """The numpy expression the Python loop replaced."""
+    assert clusters.moved_each is not None and clusters.moved_refs is not None
+    since = np.isfinite(clusters.moved_refs) & (clusters.moved_refs >= born - 1e-9)
+    return float(clusters.moved_each[c][since].max(initial=0.0))
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_score_since_birth_is_numpys_masked_maximum(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    refs = np.array([np.nan, 9.0, 9.5, 10.0 - 1e-10, 10.0])  # one older than any scan
+    each = rng.uniform(0.0, 1.0, (6, refs.size))
+    each[rng.random(each.shape) < 0.3] = 0.0
+    each[1, 3] = np.nan  # a score that could not be measured
+    clusters = chain(each, refs)
+    rows = _Rows.of(clusters)
+    for c in range(each.shape[0]):
+        for born in (0.0, 9.0, 9.0 + 1e-10, 9.2, 10.0, 11.0):
+            got, want = _moved_since_born(rows, c, born), numpy_score(clusters, c, born)
+            assert got == want or (math.isnan(got) and math.isnan(want))
+    assert math.isnan(_moved_since_born(rows, 1, 9.2))
+    assert _moved_since_born(rows, 0, 11.0) == 0.0  # no earlier scan since: nothing moved
+
+
+def test_without_the_per_scan_scores_the_chains_own_score_counts() -> None:
+    each = np.array([[0.2, 0.7], [0.0, 0.1]])
+    clusters = chain(each, np.array([1.0, 2.0]))
+    bare = dataclasses.replace(clusters, moved_each=None, moved_refs=None)
+    rows = _Rows.of(bare)
+    assert [_moved_since_born(rows, c, 5.0) for c in range(2)] == [0.7, 0.1]
