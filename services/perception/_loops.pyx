@@ -103,7 +103,8 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
     cdef Py_ssize_t n = counts.shape[0]
     cdef Py_ssize_t i, c
     cdef double px, py, share
-    cdef bint vacated
+    cdef bint vacated = False
+    cdef bint tested
     cdef long[::1] entered = np.zeros(n, dtype=np.int64)
     cdef long[::1] near = np.zeros(n, dtype=np.int64)
     cdef long[::1] gone = np.zeros(n, dtype=np.int64)
@@ -118,9 +119,13 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
     for i in range(past_points.shape[0]):
         px = past_points[i, 0]
         py = past_points[i, 1]
-        vacated = free_at(px, py, x, y, heading, ranges, angle_min, angle_increment, margin)
+        tested = False  # the free-space test only for a point inside some box
         for c in range(n):
             if lo[c, 0] <= px <= hi[c, 0] and lo[c, 1] <= py <= hi[c, 1]:
+                if not tested:
+                    vacated = free_at(px, py, x, y, heading, ranges, angle_min,
+                                      angle_increment, margin)
+                    tested = True
                 near[c] += 1
                 if vacated:
                     gone[c] += 1
