@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from zenav.services.perception import clustering
+from zenav.services.perception import _loops
 from zenav.services.perception.clustering import (
     EDGE_CLIPPED,
     EDGE_OCCLUDED,
@@ -164,13 +164,13 @@ def test_every_edge_code_and_the_speck_filter_occur() -> None:
 def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
     for name in ("run_bounds", "run_shapes", "edge_ranges", "edge_codes"):
-        real = getattr(clustering._loops, name)
+        real = getattr(_loops, name)
 
         def counted(*args: object, _real: object = real, _name: str = name) -> object:
             calls.append(_name)
             return _real(*args)  # type: ignore[operator]
 
-        monkeypatch.setattr(clustering._loops, name, counted)
+        monkeypatch.setattr(_loops, name, counted)
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
     assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes"]
