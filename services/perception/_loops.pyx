@@ -1,12 +1,36 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Perception's compiled inner loop (Cython, built at install): the motion cue's
-free-space test, point by point, with the floating-point operations of the numpy code it
-replaced, in the same order (the bearing wrapped by ``_angles.pxi``).
-``motion_cue.seen_free`` owns the meaning; ``_loops.pyi`` gives the types."""
+"""Perception's compiled inner loops (Cython, built at install): the clustering's
+passes over points and runs (the Eq. 3 cuts, each run's box, end points and radius, the
+edge codes) and the motion cue's (the free-space test, point by point, the grouping of
+a scan's points by cluster and the scores against an earlier scan), with the
+floating-point operations of the numpy code they replaced, in the same order (the
+bearing wrapped by ``_angles.pxi``). ``clustering.py`` and ``motion_cue.py`` own the
+meaning and the equations (Eq. 3's threshold comes in as an array from
+``clustering.join_threshold``); ``_loops.pyi`` gives the types."""
 
-from libc.math cimport atan2, hypot, rint
+import numpy as np
+
+from libc.math cimport INFINITY, atan2, hypot, rint, sqrt
 
 include "../_angles.pxi"
+
+
+cdef inline bint free_at(double px, double py, double x, double y, double heading,
+                        const double[::1] ranges, double angle_min, double angle_increment,
+                        double margin) noexcept:
+    """Whether the beam nearest the point (half to even, as ``np.rint``) and both its
+    neighbours reached more than ``margin`` beyond it (a nan point: no beam)."""
+    cdef Py_ssize_t n = ranges.shape[0]
+    cdef Py_ssize_t b
+    cdef double dx = px - x
+    cdef double dy = py - y
+    cdef double distance = hypot(dx, dy)
+    cdef double bearing = wrap_angle(atan2(dy, dx) - heading)
+    cdef double beam = rint((bearing - angle_min) / angle_increment)
+    if not (1 <= beam <= n - 2):
+        return False
+    b = <Py_ssize_t>beam
+    return min(ranges[b - 1], ranges[b], ranges[b + 1]) > distance + margin
 
 
 def seen_free(const double[:, ::1] points, double x, double y, double heading,
@@ -15,35 +39,211 @@ def seen_free(const double[:, ::1] points, double x, double y, double heading,
     """For each point, whether the beams toward it and both neighbours reached more
     than ``margin`` beyond it: the beam
     the nearest to it (half to even, as ``np.rint``)."""
-    cdef Py_ssize_t n = ranges.shape[0]
-    cdef Py_ssize_t i, b
-    cdef double dx, dy, distance, bearing, beam, reach
+    cdef Py_ssize_t i
     for i in range(points.shape[0]):
-        dx = points[i, 0] - x
-        dy = points[i, 1] - y
-        distance = hypot(dx, dy)
-        bearing = wrap_angle(atan2(dy, dx) - heading)
-        beam = rint((bearing - angle_min) / angle_increment)
-        if not (1 <= beam <= n - 2):  # (a nan point: no beam either)
-            out[i] = 0
+        out[i] = free_at(points[i, 0], points[i, 1], x, y, heading, ranges, angle_min,
+                         angle_increment, margin)
+
+
+def group_points(const long[:, ::1] cluster_beams, const long[::1] window_beams,
+                 const double[:, ::1] window_points, Py_ssize_t n_beams, double reach,
+                 long[::1] member, double[:, ::1] points, long[::1] counts,
+                 double[:, ::1] lo, double[:, ::1] hi):
+    """The window points that belong to a cluster (beams ``first..last`` of its row in
+    ``cluster_beams``; a later row wins a beam two rows hold), in window order: the
+    cluster of each (``member``), the point (``points``), the points per cluster
+    (``counts``, added to) and each cluster's bounding box widened by ``reach``
+    (``lo``, ``hi``; a cluster without points keeps +inf / -inf). Returns how many
+    points were kept (the rows of ``member`` and ``points`` filled)."""
+    cdef Py_ssize_t k, b, i, c
+    cdef Py_ssize_t kept = 0
+    cdef long[::1] owner = np.full(n_beams, -1, dtype=np.int64)
+    for k in range(cluster_beams.shape[0]):
+        for b in range(max(cluster_beams[k, 0], 0), min(cluster_beams[k, 1] + 1, n_beams)):
+            owner[b] = k
+    for c in range(lo.shape[0]):
+        lo[c, 0] = INFINITY
+        lo[c, 1] = INFINITY
+        hi[c, 0] = -INFINITY
+        hi[c, 1] = -INFINITY
+    for i in range(window_beams.shape[0]):
+        c = owner[window_beams[i]]
+        if c < 0:
             continue
-        b = <Py_ssize_t>beam
-        reach = min(ranges[b - 1], ranges[b], ranges[b + 1])
-        out[i] = reach > distance + margin
+        member[kept] = c
+        points[kept, 0] = window_points[i, 0]
+        points[kept, 1] = window_points[i, 1]
+        counts[c] += 1
+        lo[c, 0] = min(lo[c, 0], window_points[i, 0])
+        lo[c, 1] = min(lo[c, 1], window_points[i, 1])
+        hi[c, 0] = max(hi[c, 0], window_points[i, 0])
+        hi[c, 1] = max(hi[c, 1], window_points[i, 1])
+        kept += 1
+    for c in range(lo.shape[0]):
+        lo[c, 0] -= reach
+        lo[c, 1] -= reach
+        hi[c, 0] += reach
+        hi[c, 1] += reach
+    return kept
 
 
-def count_in_boxes(const double[:, ::1] points, const unsigned char[::1] flags,
-                   const double[:, ::1] lo, const double[:, ::1] hi, long[::1] inside,
-                   long[::1] flagged):
-    """For each box (closed, ``lo`` to ``hi``), how many of the points lie in it
-    (``inside``) and how many of those are flagged (``flagged``), both added to."""
+def free_scores(const double[:, ::1] points, const long[::1] member, const long[::1] counts,
+                double past_x, double past_y, double past_heading,
+                const double[::1] past_ranges, double past_angle_min,
+                double past_angle_increment, const double[:, ::1] past_points,
+                double x, double y, double heading, const double[::1] ranges,
+                double angle_min, double angle_increment, const double[:, ::1] lo,
+                const double[:, ::1] hi, double margin, double[::1] scores):
+    """Per cluster, the larger of the share of its points (``points`` of cluster
+    ``member``, ``counts`` per cluster) that the earlier scan saw as free space
+    (``free_at`` its pose and ranges), and the share of the earlier scan's points
+    (``past_points``, when there are two or more) inside its box (``lo`` to ``hi``,
+    closed) that the current scan sees through; 0 with no points or fewer than two
+    inside. ``scores`` is filled."""
+    cdef Py_ssize_t n = counts.shape[0]
     cdef Py_ssize_t i, c
-    cdef double px, py
+    cdef double px, py, share
+    cdef bint vacated = False
+    cdef bint tested
+    cdef long[::1] entered = np.zeros(n, dtype=np.int64)
+    cdef long[::1] near = np.zeros(n, dtype=np.int64)
+    cdef long[::1] gone = np.zeros(n, dtype=np.int64)
     for i in range(points.shape[0]):
-        px = points[i, 0]
-        py = points[i, 1]
-        for c in range(lo.shape[0]):
+        if free_at(points[i, 0], points[i, 1], past_x, past_y, past_heading, past_ranges,
+                   past_angle_min, past_angle_increment, margin):
+            entered[member[i]] += 1
+    for c in range(n):
+        scores[c] = <double>entered[c] / <double>counts[c] if counts[c] > 0 else 0.0
+    if past_points.shape[0] < 2:
+        return
+    for i in range(past_points.shape[0]):
+        px = past_points[i, 0]
+        py = past_points[i, 1]
+        tested = False  # the free-space test only for a point inside some box
+        for c in range(n):
             if lo[c, 0] <= px <= hi[c, 0] and lo[c, 1] <= py <= hi[c, 1]:
-                inside[c] += 1
-                if flags[i]:
-                    flagged[c] += 1
+                if not tested:
+                    vacated = free_at(px, py, x, y, heading, ranges, angle_min,
+                                      angle_increment, margin)
+                    tested = True
+                near[c] += 1
+                if vacated:
+                    gone[c] += 1
+    for c in range(n):
+        if near[c] >= 2:
+            share = <double>gone[c] / <double>near[c]
+            if share > scores[c]:
+                scores[c] = share
+
+
+def run_bounds(const double[::1] px, const double[::1] py, const double[::1] threshold,
+               long[::1] starts, long[::1] ends, long[::1] counts):
+    """Cut the chain of points ``(px, py)`` where two consecutive points lie farther
+    apart than ``threshold`` (of the later point; ``threshold[i - 1]`` for points
+    ``i - 1`` and ``i``, compared squared): the first and last point and the number of
+    points of each run (``starts``, ``ends``, ``counts``, filled from the front).
+    Returns the number of runs."""
+    cdef Py_ssize_t m = px.shape[0]
+    cdef Py_ssize_t i
+    cdef Py_ssize_t k = 1
+    cdef double dx, dy, t
+    starts[0] = 0
+    for i in range(1, m):
+        dx = px[i] - px[i - 1]
+        dy = py[i] - py[i - 1]
+        t = threshold[i - 1]
+        if dx * dx + dy * dy > t * t:
+            ends[k - 1] = i - 1
+            starts[k] = i
+            k += 1
+    ends[k - 1] = m - 1
+    for i in range(k):
+        counts[i] = ends[i] - starts[i] + 1
+    return k
+
+
+def run_shapes(const double[::1] px, const double[::1] py, const long[::1] starts,
+               const long[::1] ends, double inset, double[:, ::1] edges,
+               double[:, ::1] first_point, double[:, ::1] last_point, double[:, ::1] chord,
+               double[::1] radius):
+    """For each run of points ``starts[c]..ends[c]``: its bounding box shrunk by
+    ``inset`` on each side, never past its middle (``edges``: x_min, x_max, y_min,
+    y_max), its first and last point, their midpoint (``chord``) and the largest
+    distance from that midpoint to a point of the run (``radius``)."""
+    cdef Py_ssize_t c, i
+    cdef double lo_x, hi_x, lo_y, hi_y, in_x, in_y, cx, cy, ex, ey, d2, far
+    for c in range(starts.shape[0]):
+        lo_x = hi_x = px[starts[c]]
+        lo_y = hi_y = py[starts[c]]
+        for i in range(starts[c] + 1, ends[c] + 1):
+            lo_x = min(lo_x, px[i])
+            hi_x = max(hi_x, px[i])
+            lo_y = min(lo_y, py[i])
+            hi_y = max(hi_y, py[i])
+        in_x = min(inset, (hi_x - lo_x) / 2)
+        in_y = min(inset, (hi_y - lo_y) / 2)
+        edges[c, 0] = lo_x + in_x
+        edges[c, 1] = hi_x - in_x
+        edges[c, 2] = lo_y + in_y
+        edges[c, 3] = hi_y - in_y
+        first_point[c, 0] = px[starts[c]]
+        first_point[c, 1] = py[starts[c]]
+        last_point[c, 0] = px[ends[c]]
+        last_point[c, 1] = py[ends[c]]
+        cx = 0.5 * (px[starts[c]] + px[ends[c]])
+        cy = 0.5 * (py[starts[c]] + py[ends[c]])
+        chord[c, 0] = cx
+        chord[c, 1] = cy
+        far = -INFINITY
+        for i in range(starts[c], ends[c] + 1):
+            ex = px[i] - cx
+            ey = py[i] - cy
+            d2 = ex * ex + ey * ey
+            far = max(far, d2)
+        radius[c] = sqrt(far)
+
+
+def edge_ranges(const double[::1] ranges, const unsigned char[::1] valid,
+                const long[:, ::1] beams, double[:, ::1] rho_edge,
+                double[:, ::1] rho_next, double[:, ::1] rho_top,
+                unsigned char[:, ::1] has, unsigned char[:, ::1] outside):
+    """For each end of each cluster (``beams``: first, last beam), the beam beside it
+    (first - 1, last + 1): whether it lies outside the scan (``outside``), whether it has
+    a return (``has``, ``valid`` there), the range at the end (``rho_edge``), the
+    neighbour's range (``rho_next``, 0 without a return) and the larger of the two
+    (``rho_top``)."""
+    cdef Py_ssize_t n = ranges.shape[0]
+    cdef Py_ssize_t c, j, b
+    for c in range(beams.shape[0]):
+        for j in range(2):
+            b = beams[c, j] + (1 if j else -1)
+            outside[c, j] = b < 0 or b >= n
+            has[c, j] = (not outside[c, j]) and valid[b]
+            rho_edge[c, j] = ranges[beams[c, j]]
+            rho_next[c, j] = ranges[b] if has[c, j] else 0.0
+            rho_top[c, j] = max(rho_edge[c, j], rho_next[c, j])
+
+
+def edge_codes(const double[:, ::1] rho_edge, const double[:, ::1] rho_next,
+               const unsigned char[:, ::1] has, const unsigned char[:, ::1] outside,
+               const double[:, ::1] join_top, const double[:, ::1] join_edge,
+               double cos2, double window_radius, long[:, ::1] codes):
+    """The code of what lies beside each end (``edge_ranges`` gave the ranges):
+    2 (clipped) outside the scan, or for a return beyond ``window_radius`` within
+    ``join_top`` (the join threshold of the larger range) of the end point, the distance
+    by the law of cosines (``cos2``: twice the cosine of the beam step); else 1
+    (occluded) for a return nearer than the end by more than ``join_edge``; else 0."""
+    cdef Py_ssize_t c, j
+    cdef double re, rn, d2, t
+    for c in range(rho_edge.shape[0]):
+        for j in range(2):
+            re = rho_edge[c, j]
+            rn = rho_next[c, j]
+            d2 = re * re + rn * rn - cos2 * re * rn
+            t = join_top[c, j]
+            if outside[c, j] or (has[c, j] and rn > window_radius and d2 <= t * t):
+                codes[c, j] = 2
+            elif has[c, j] and rn < re - join_edge[c, j]:
+                codes[c, j] = 1
+            else:
+                codes[c, j] = 0

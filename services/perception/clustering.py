@@ -1,8 +1,9 @@
 """Adaptive-threshold nearest-neighbour clustering of one laser scan (paper Section 3.1-3.2).
 
-Pure numpy: :func:`cluster_scan` takes the scan in the ROS LaserScan convention and the robot
-pose at scan time, and returns a :class:`Clusters` record, one row per obstacle in scan order
-(the obstacle chain O_chain(t) of Eq. 4).
+Pure functions: :func:`cluster_scan` takes the scan in the ROS LaserScan convention and the
+robot pose at scan time, and returns a :class:`Clusters` record, one row per obstacle in scan
+order (the obstacle chain O_chain(t) of Eq. 4). The equations are numpy functions of this
+module; the passes over points and runs between them are compiled (``_loops.pyx``).
 
 Conventions
 -----------
@@ -43,6 +44,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.perception import _loops
 from zenav.services.perception.params import PerceptionParams
 
 FloatArray = npt.NDArray[np.float64]
@@ -225,7 +227,7 @@ def cluster_scan(
         consecutive points inside the window (skipping beams that are not) join when their
         Euclidean distance is at most the Eq. 3 threshold of the current point.
     """
-    r = np.asarray(ranges, dtype=np.float64)
+    r = np.ascontiguousarray(ranges, dtype=np.float64)
     cell = params.cell
     # NaN compares False everywhere, so it drops out as "no return" like inf does.
     valid = (r >= range_min) & (r < range_max)
@@ -239,20 +241,12 @@ def cluster_scan(
     px, py = to_global(pose, rho, alpha)  # Eq. 1
 
     # Eq. 3: a new cluster starts where the distance to the previous point exceeds theta
-    # (compared squared, both sides are non-negative).
-    dx = px[1:] - px[:-1]
-    dy = py[1:] - py[:-1]
+    # (compared squared, both sides are non-negative; compiled, one pass).
     thr = join_threshold(rho[1:], angle_increment, params)
-    breaks = (dx * dx + dy * dy > thr * thr).nonzero()[0] + 1
     m = idx.size
-    k = breaks.size + 1
-    starts = np.empty(k, dtype=np.int64)
-    starts[0] = 0
-    starts[1:] = breaks
-    ends = np.empty(k, dtype=np.int64)
-    ends[:-1] = breaks - 1
-    ends[-1] = m - 1
-    counts = ends - starts + 1
+    starts, ends, counts = (np.empty(m, dtype=np.int64) for _ in range(3))
+    k = _loops.run_bounds(px, py, thr, starts, ends, counts)
+    starts, ends, counts = starts[:k], ends[:k], counts[:k]
 
     if params.min_beams > 1:
         keep = counts >= params.min_beams
@@ -277,30 +271,21 @@ def cluster_scan(
     # middle) before Eq. 2: an obstacle edge that lies on a cell boundary, as the edges
     # of boxes laid out on the grid do, then stays in the obstacle's cell instead of
     # spilling into the free one beside it, whichever way range noise moved the point.
-    inset = params.edge_inset
-    lo_x, hi_x = np.minimum.reduceat(px, starts), np.maximum.reduceat(px, starts)
-    lo_y, hi_y = np.minimum.reduceat(py, starts), np.maximum.reduceat(py, starts)
-    in_x = np.minimum(inset, (hi_x - lo_x) / 2)
-    in_y = np.minimum(inset, (hi_y - lo_y) / 2)
-    box = np.column_stack((grid_index(lo_x + in_x, cell), grid_index(hi_x - in_x, cell),
-                           grid_index(lo_y + in_y, cell), grid_index(hi_y - in_y, cell)))
-    area = box_area(box)  # Eq. 6
-
+    # The boxes, end points, chord centres and radii in one compiled pass over the runs.
+    edges = np.empty((k, 4))
     first_point = np.empty((k, 2))
-    first_point[:, 0] = px[starts]
-    first_point[:, 1] = py[starts]
     last_point = np.empty((k, 2))
-    last_point[:, 0] = px[ends]
-    last_point[:, 1] = py[ends]
-    chord = 0.5 * (first_point + last_point)
-    ex = px - chord[:, 0].repeat(counts)
-    ey = py - chord[:, 1].repeat(counts)
-    radius = np.sqrt(np.maximum.reduceat(ex * ex + ey * ey, starts))
+    chord = np.empty((k, 2))
+    radius = np.empty(k)
+    _loops.run_shapes(px, py, starts, ends, params.edge_inset, edges, first_point, last_point,
+                      chord, radius)
+    box = grid_index(edges, cell)  # Eq. 2: ix_min, ix_max, iy_min, iy_max
+    area = box_area(box)  # Eq. 6
 
     beams = np.empty((k, 2), dtype=np.int64)
     beams[:, 0] = idx[starts]
     beams[:, 1] = idx[ends]
-    edges = _edge_codes(r, valid, beams, angle_increment, params)
+    codes = _edge_codes(r, valid, beams, angle_increment, params)
 
     return Clusters(
         centre=centre,
@@ -314,8 +299,8 @@ def cluster_scan(
         last_point=last_point,
         chord_centre=chord,
         radius=radius,
-        edge_start=edges[:, 0],
-        edge_end=edges[:, 1],
+        edge_start=codes[:, 0],
+        edge_end=codes[:, 1],
         pose=(float(x_r), float(y_r), float(th_r)),
         cell=cell,
     )
@@ -345,17 +330,17 @@ def _edge_codes(
     * a return nearer than the edge point by more than the join threshold -> EDGE_OCCLUDED;
     * anything else (background behind, or a surface that did not join) -> EDGE_FREE.
     """
-    nb = beams + np.array([-1, 1], dtype=np.int64)
-    outside = (nb < 0) | (nb >= r.shape[0])
-    nb[outside] = 0
-    has = valid[nb] & ~outside
-    rho_e = r[beams]
-    rho_n = np.where(has, r[nb], 0.0)  # no arithmetic on inf / NaN readings
-    # Distance between the two points by the law of cosines (the angle between them is known).
-    d2 = rho_e * rho_e + rho_n * rho_n - (2.0 * math.cos(angle_increment)) * rho_e * rho_n
-    thr = join_threshold(np.maximum(rho_e, rho_n), angle_increment, params)  # Eq. 3
-    codes = np.zeros(beams.shape, dtype=np.int64)
-    nearer = rho_n < rho_e - join_threshold(rho_e, angle_increment, params)
-    codes[has & nearer] = EDGE_OCCLUDED
-    codes[outside | (has & (rho_n > params.window_radius) & (d2 <= thr * thr))] = EDGE_CLIPPED
+    k = beams.shape[0]
+    rho_edge, rho_next, rho_top = np.empty((k, 2)), np.empty((k, 2)), np.empty((k, 2))
+    has, outside = np.empty((k, 2), dtype=np.uint8), np.empty((k, 2), dtype=np.uint8)
+    _loops.edge_ranges(r, valid.view(np.uint8), beams, rho_edge, rho_next, rho_top, has,
+                       outside)
+    codes = np.empty((k, 2), dtype=np.int64)
+    # Eq. 3 of the larger range (would the neighbour have joined?) and of the end's own
+    # range (is the neighbour nearer by more than that?); the distance between the two
+    # points by the law of cosines (the angle between them is known).
+    _loops.edge_codes(rho_edge, rho_next, has, outside,
+                      join_threshold(rho_top, angle_increment, params),
+                      join_threshold(rho_edge, angle_increment, params),
+                      2.0 * math.cos(angle_increment), params.window_radius, codes)
     return codes

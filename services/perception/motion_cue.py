@@ -81,55 +81,49 @@ class ClusterPoints:
 def cluster_points(current: ScanSnapshot, cluster_beams: IntArray, window_beams: IntArray,
                    reach: float, window_points: FloatArray | None = None
                    ) -> ClusterPoints | None:
-    """The clustered points of ``current`` (None when no cluster has a window beam)."""
+    """The clustered points of ``current`` (None when no cluster has a window beam).
+
+    A window beam belongs to the cluster whose beam span holds it; each cluster's box is
+    the bounding box of its points widened by ``reach`` (compiled, one pass:
+    ``_loops.group_points``)."""
     n = len(cluster_beams)
     if n == 0 or len(window_beams) == 0:
         return None
-    # Which cluster each window beam belongs to (-1: none), in one pass.
-    owner = np.full(current.ranges.shape[0], -1, dtype=np.int64)
-    for k, (first, last) in enumerate(cluster_beams):
-        owner[first: last + 1] = k
-    owned = owner[window_beams] >= 0
-    beams = window_beams[owned]
-    if len(beams) == 0:
+    beams = np.ascontiguousarray(window_beams, dtype=np.int64)
+    if window_points is None:
+        window_points = current.points(beams)
+    m = beams.shape[0]
+    member = np.empty(m, dtype=np.int64)
+    points = np.empty((m, 2))
+    counts = np.zeros(n, dtype=np.int64)
+    lo = np.empty((n, 2))
+    hi = np.empty((n, 2))
+    kept = _loops.group_points(np.ascontiguousarray(cluster_beams, dtype=np.int64), beams,
+                               np.ascontiguousarray(window_points, dtype=np.float64),
+                               current.ranges.shape[0], reach, member, points, counts, lo, hi)
+    if kept == 0:
         return None
-    member = owner[beams]
-    points = (current.points(beams) if window_points is None else window_points[owned])
-    counts = np.bincount(member, minlength=n)
-    lo = np.full((n, 2), np.inf)
-    hi = np.full((n, 2), -np.inf)
-    # Each cluster's bounding box: its points grouped by cluster, then one min and
-    # one max per group (exact, as np.minimum.at would give, without its slow path).
-    order = np.argsort(member, kind="stable")
-    grouped, ordered = member[order], points[order]
-    starts = np.flatnonzero(np.r_[True, grouped[1:] != grouped[:-1]])
-    lo[grouped[starts]] = np.minimum.reduceat(ordered, starts, axis=0)
-    hi[grouped[starts]] = np.maximum.reduceat(ordered, starts, axis=0)
-    lo -= reach
-    hi += reach
-    return ClusterPoints(n, member, points, counts, lo, hi)
+    return ClusterPoints(n, member[:kept], points[:kept], counts, lo, hi)
 
 
 def scores_against(clustered: ClusterPoints, current: ScanSnapshot, past: ScanSnapshot,
                    past_points: FloatArray, margin: float) -> FloatArray:
     """(n,) score in [0, 1] per cluster of ``clustered`` against the earlier scan
-    ``past`` (``past_points``: the global points of its window beams)."""
-    n, member = clustered.n, clustered.member
-    counts = clustered.counts
-    entered = np.bincount(member, weights=seen_free(past, clustered.points, margin),
-                          minlength=n)
-    scores = np.divide(entered, counts, out=np.zeros(n), where=counts > 0)
-    if len(past_points) >= 2:
-        vacated = seen_free(current, past_points, margin)
-        # The earlier points inside each cluster's widened box, and how many of them the
-        # current scan sees through (compiled: one pass over points and boxes).
-        n_near = np.zeros(n, dtype=np.int64)
-        gone = np.zeros(n, dtype=np.int64)
-        _loops.count_in_boxes(np.ascontiguousarray(past_points, dtype=np.float64),
-                              vacated.view(np.uint8), clustered.lo, clustered.hi, n_near,
-                              gone)
-        share = np.divide(gone, n_near, out=np.zeros(n), where=n_near >= 2)
-        scores = np.maximum(scores, share)
+    ``past`` (``past_points``: the global points of its window beams): the larger of
+    the share of its points that ``past`` saw as free space (*entered*) and the share of
+    the earlier points inside its widened box, two at least, that ``current`` sees
+    through (*vacated*). Compiled, one pass over the points (``_loops.free_scores``,
+    with the test of :func:`seen_free`)."""
+    scores = np.empty(clustered.n)
+    px, py, ph = past.pose
+    x, y, heading = current.pose
+    _loops.free_scores(clustered.points, clustered.member, clustered.counts, px, py, ph,
+                       np.ascontiguousarray(past.ranges, dtype=np.float64), past.angle_min,
+                       past.angle_increment,
+                       np.ascontiguousarray(past_points, dtype=np.float64).reshape(-1, 2),
+                       x, y, heading, np.ascontiguousarray(current.ranges, dtype=np.float64),
+                       current.angle_min, current.angle_increment, clustered.lo, clustered.hi,
+                       margin, scores)
     return scores
 
 

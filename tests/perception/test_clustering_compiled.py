@@ -1,0 +1,176 @@
+"""The clustering's compiled passes (``_loops.run_bounds``, ``run_shapes``,
+``edge_ranges`` and ``edge_codes``, what ``cluster_scan`` calls) give, to the bit, the
+obstacle chain of the numpy code they replaced, field by field."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from zenav.services.perception import _loops
+from zenav.services.perception.clustering import (
+    EDGE_CLIPPED,
+    EDGE_OCCLUDED,
+    Clusters,
+    Pose,
+    box_area,
+    cluster_means,
+    cluster_scan,
+    grid_index,
+    join_threshold,
+    to_global,
+)
+from zenav.services.perception.params import PerceptionParams
+
+HALF_DEG = math.radians(0.5)
+
+
+def numpy_edge_codes(r: np.ndarray, valid: np.ndarray, beams: np.ndarray,
+                     angle_increment: float, params: PerceptionParams) -> np.ndarray:
+    """The edge codes as numpy array operations (the code the compiled passes replaced)."""
+    nb = beams + np.array([-1, 1], dtype=np.int64)
+    outside = (nb < 0) | (nb >= r.shape[0])
+    nb[outside] = 0
+    has = valid[nb] & ~outside
+    rho_e = r[beams]
+    rho_n = np.where(has, r[nb], 0.0)
+    d2 = rho_e * rho_e + rho_n * rho_n - (2.0 * math.cos(angle_increment)) * rho_e * rho_n
+    thr = join_threshold(np.maximum(rho_e, rho_n), angle_increment, params)
+    codes = np.zeros(beams.shape, dtype=np.int64)
+    nearer = rho_n < rho_e - join_threshold(rho_e, angle_increment, params)
+    codes[has & nearer] = EDGE_OCCLUDED
+    codes[outside | (has & (rho_n > params.window_radius) & (d2 <= thr * thr))] = EDGE_CLIPPED
+    return codes
+
+
+def numpy_cluster_scan(ranges: np.ndarray, angle_min: float, angle_increment: float,
+                       range_min: float, range_max: float, pose: Pose,
+                       params: PerceptionParams) -> Clusters:
+    """``cluster_scan`` as numpy array operations (the code the compiled passes replaced)."""
+    r = np.asarray(ranges, dtype=np.float64)
+    cell = params.cell
+    valid = (r >= range_min) & (r < range_max)
+    idx = np.flatnonzero(valid & (r <= params.window_radius))
+    if idx.size == 0:
+        return Clusters.empty(pose, cell)
+    rho = r[idx]
+    alpha = angle_min + idx * angle_increment
+    px, py = to_global(pose, rho, alpha)
+    dx = px[1:] - px[:-1]
+    dy = py[1:] - py[:-1]
+    thr = join_threshold(rho[1:], angle_increment, params)
+    breaks = (dx * dx + dy * dy > thr * thr).nonzero()[0] + 1
+    m = idx.size
+    starts = np.r_[0, breaks].astype(np.int64)
+    ends = np.r_[breaks - 1, m - 1].astype(np.int64)
+    counts = ends - starts + 1
+    if params.min_beams > 1:
+        keep = counts >= params.min_beams
+        if not keep.all():
+            starts, ends, counts = starts[keep], ends[keep], counts[keep]
+            if starts.size == 0:
+                return Clusters.empty(pose, cell)
+            sel = np.concatenate([np.arange(s, e + 1) for s, e in zip(starts, ends, strict=True)])
+            rho, alpha, px, py, idx = rho[sel], alpha[sel], px[sel], py[sel], idx[sel]
+            ends = np.cumsum(counts) - 1
+            starts = ends - counts + 1
+    mean_rho, mean_alpha = cluster_means(rho, alpha, starts, counts)
+    centre = np.column_stack(to_global(pose, mean_rho, mean_alpha))
+    inset = params.edge_inset
+    lo_x, hi_x = np.minimum.reduceat(px, starts), np.maximum.reduceat(px, starts)
+    lo_y, hi_y = np.minimum.reduceat(py, starts), np.maximum.reduceat(py, starts)
+    in_x = np.minimum(inset, (hi_x - lo_x) / 2)
+    in_y = np.minimum(inset, (hi_y - lo_y) / 2)
+    box = np.column_stack((grid_index(lo_x + in_x, cell), grid_index(hi_x - in_x, cell),
+                           grid_index(lo_y + in_y, cell), grid_index(hi_y - in_y, cell)))
+    first_point = np.column_stack((px[starts], py[starts]))
+    last_point = np.column_stack((px[ends], py[ends]))
+    chord = 0.5 * (first_point + last_point)
+    ex = px - chord[:, 0].repeat(counts)
+    ey = py - chord[:, 1].repeat(counts)
+    radius = np.sqrt(np.maximum.reduceat(ex * ex + ey * ey, starts))
+    beams = np.column_stack((idx[starts], idx[ends]))
+    edges = numpy_edge_codes(r, valid, beams, angle_increment, params)
+    x_r, y_r, th_r = pose
+    return Clusters(centre=centre, mean_rho=mean_rho, mean_alpha=mean_alpha, box=box,
+                    area=box_area(box), beams=beams, n_beams=counts, first_point=first_point,
+                    last_point=last_point, chord_centre=chord, radius=radius,
+                    edge_start=edges[:, 0], edge_end=edges[:, 1],
+                    pose=(float(x_r), float(y_r), float(th_r)), cell=cell)
+
+
+def random_ranges(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Surfaces of random width and slope, gaps, readings past the window, nan and inf."""
+    r = np.full(n, np.inf)
+    i = 0
+    while i < n:
+        width = int(rng.integers(1, 25))
+        start = rng.uniform(0.2, 6.0)
+        r[i: i + width] = (start + rng.uniform(-0.05, 0.05) * np.arange(width)
+                           + rng.normal(0, 0.01, width))[: n - i]
+        i += width + int(rng.integers(0, 4))
+    r[rng.random(n) < 0.03] = np.nan
+    r[rng.random(n) < 0.02] = 0.01  # under range_min
+    return r.astype(np.float32)
+
+
+def same(a: Clusters, b: Clusters) -> None:
+    for f in dataclasses.fields(Clusters):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray):
+            assert isinstance(y, np.ndarray), f.name
+            assert (x.dtype, x.shape, x.tobytes()) == (y.dtype, y.shape, y.tobytes()), f.name
+        else:
+            assert repr(x) == repr(y), f.name
+
+
+PARAMS = [PerceptionParams(), PerceptionParams.paper(),
+          PerceptionParams(min_beams=4, edge_inset=0.2, gap_floor=0.05, window_radius=3.0)]
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_the_chain_is_the_numpy_one_to_the_bit(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([3, 50, 361, 720]))
+    ranges = random_ranges(rng, n)
+    pose = (float(rng.uniform(-20, 20)), float(rng.uniform(-20, 20)), float(rng.uniform(-7, 7)))
+    for params in PARAMS:
+        got = cluster_scan(ranges, -math.pi / 2, HALF_DEG, 0.05, 8.0, pose, params)
+        want = numpy_cluster_scan(ranges, -math.pi / 2, HALF_DEG, 0.05, 8.0, pose, params)
+        same(got, want)
+
+
+def test_every_edge_code_and_the_speck_filter_occur() -> None:
+    """The random scans above reach each edge code, and the speck filter drops runs."""
+    codes: set[int] = set()
+    dropped = False
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        n = int(rng.choice([3, 50, 361, 720]))
+        ranges = random_ranges(rng, n)
+        for params in PARAMS:
+            c = cluster_scan(ranges, -math.pi / 2, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0), params)
+            codes |= set(c.edge_start.tolist()) | set(c.edge_end.tolist())
+            if params.min_beams > 1:
+                one = cluster_scan(ranges, -math.pi / 2, HALF_DEG, 0.05, 8.0,
+                                   (0.0, 0.0, 0.0), params.model_copy(update={"min_beams": 1}))
+                dropped |= len(one) > len(c)
+    assert codes == {0, 1, 2} and dropped
+
+
+def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
+    calls: list[str] = []
+    for name in ("run_bounds", "run_shapes", "edge_ranges", "edge_codes"):
+        real = getattr(_loops, name)
+
+        def counted(*args: object, _real: object = real, _name: str = name) -> object:
+            calls.append(_name)
+            return _real(*args)  # type: ignore[operator]
+
+        monkeypatch.setattr(_loops, name, counted)
+    cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
+                 PerceptionParams())
+    assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes"]
