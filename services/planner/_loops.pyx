@@ -3,18 +3,20 @@
 
 numpy ran these as one pass over whole arrays per step, which costs more in call
 overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
-over the map, about 41,000 samples a scan in the perf world, and the marking) and the
-unicycle roll-out of every safety candidate over the horizon. Here they are plain loops
-with the same floating-point operations, in the same order, as the numpy code they
-replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors of the cell
-indices as numpy has them), so the results are the same to the bit. The Python callers
-(``costmap.py``, ``safety.py``) own the meaning; ``_loops.pyi`` gives their types.
+over the map, about 41,000 samples a scan in the perf world, and the marking), the
+unicycle roll-out of every safety candidate over the horizon, and the collision
+prediction's gaps between the path and each standing obstacle's grid area. Here they
+are plain loops with the same floating-point operations, in the same order, as the
+numpy code they replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors
+of the cell indices as numpy has them), so the results are the same to the bit. The
+Python callers (``costmap.py``, ``safety.py``, ``prediction.py``) own the meaning;
+``_loops.pyi`` gives their types.
 """
 
 import numpy as np
 
 cimport cython
-from libc.math cimport cos, hypot, sin, sqrt
+from libc.math cimport INFINITY, cos, hypot, sin, sqrt
 
 include "../_angles.pxi"
 
@@ -192,3 +194,30 @@ def drive(const double[::1] headings, const double[::1] speeds, double dt, doubl
             y = y + v * sin(theta) * dt
             xs[i, k] = x
             ys[i, k] = y
+
+
+def box_gaps(const double[:, ::1] points, const long[:, ::1] cells, double cell,
+             const double[::1] clearances, long[::1] first, double[::1] least):
+    """For each grid box j (row ix_min, ix_max, iy_min, iy_max of ``cells``; cell i
+    spans [(i - 1/2) cell, (i + 1/2) cell]) the gap of every point (n, 2) to it, as
+    ``prediction.assess`` measures it: ``hypot`` of how far the point is outside the box
+    along each axis, less ``clearances[j]``. Into ``first[j]`` the index of the first
+    point with a negative gap (-1: none), into ``least[j]`` the smallest gap."""
+    cdef double lo_x, lo_y, hi_x, hi_y, out_x, out_y, gap, smallest
+    cdef Py_ssize_t i, j, hit
+    for j in range(cells.shape[0]):
+        lo_x = (<double>cells[j, 0] - 0.5) * cell
+        hi_x = (<double>cells[j, 1] + 0.5) * cell
+        lo_y = (<double>cells[j, 2] - 0.5) * cell
+        hi_y = (<double>cells[j, 3] + 0.5) * cell
+        hit = -1
+        smallest = INFINITY
+        for i in range(points.shape[0]):
+            out_x = max(max(lo_x - points[i, 0], points[i, 0] - hi_x), 0.0)
+            out_y = max(max(lo_y - points[i, 1], points[i, 1] - hi_y), 0.0)
+            gap = hypot(out_x, out_y) - clearances[j]
+            if gap < 0.0 and hit < 0:
+                hit = i
+            smallest = min(smallest, gap)
+        first[j] = hit
+        least[j] = smallest

@@ -41,6 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import ObstacleKind, ScenarioLetter
+from zenav.services.planner._loops import box_gaps
 
 MeetRule = Literal["closest", "same_time"]
 """How a crosser is found to meet the robot (e); see the module notes."""
@@ -142,19 +143,20 @@ def line_crossing(p: Vec, d: Vec, c: Vec, u: Vec) -> tuple[float, float] | None:
 
 
 def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
-                 obstacle: Obstacle, gaps: Vec) -> Assessment | None:
+                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment | None:
     """(b) for a standing obstacle, from the gaps (m, clearance taken off) between its grid
-    area and each of the points along the path; None when none is negative."""
-    first = int(np.argmax(gaps < 0)) if (gaps < 0).any() else -1
+    area and each of the ``count`` points along the path: ``first``, the index of the
+    first negative one (-1: none, then None), and ``least``, the smallest."""
     if first < 0:
         return None
     along = float((np.asarray(obstacle.position, dtype=np.float64) - robot) @ direction)
-    s_hit = first * path_length / (len(gaps) - 1)
+    s_hit = first * path_length / (count - 1)
     centre_s = min(max(along, 0.0), path_length)
-    pcp = robot + direction * centre_s
-    return Assessment(obstacle, "b", True, (float(pcp[0]), float(pcp[1])), s_hit,
-                      s_hit / speed if speed > 0 else math.inf, math.inf,
-                      float(gaps.min()), along, 0.0, (float(direction[0]), float(direction[1])))
+    rx, ry = robot.tolist()
+    dx, dy = direction.tolist()
+    return Assessment(obstacle, "b", True, (rx + dx * centre_s, ry + dy * centre_s), s_hit,
+                      s_hit / speed if speed > 0 else math.inf, math.inf, least, along, 0.0,
+                      (dx, dy))
 
 
 def _moving(obstacle: Obstacle, moving_speed: float) -> bool:
@@ -181,31 +183,25 @@ def assess_all(
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
     per obstacle), the ones with something to do with the path, in order. The standing
     obstacles are measured against the path all at once: one set of path points, every
-    grid area's gaps in one array operation (element by element the same arithmetic as
-    :func:`assess`, so the same answers to the last bit)."""
+    grid area's gaps in one compiled loop (``_loops.box_gaps``: element by element the
+    same arithmetic as :func:`assess`, so the same answers to the last bit)."""
     standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
-    gaps: dict[int, Vec | None] = {}  # standing obstacles' gaps; None: clear of the path
+    on_path: dict[int, tuple[int, float]] = {}  # standing obstacles: (first, least) gap
+    count = 0
     if standing:
         points = path_points(robot, direction, path_length, cell / 4)
-        cells = np.array([obstacles[i].cells for i in standing], dtype=np.float64)
-        lows = np.column_stack([(cells[:, 0] - 0.5) * cell, (cells[:, 2] - 0.5) * cell])
-        highs = np.column_stack([(cells[:, 1] + 0.5) * cell, (cells[:, 3] + 0.5) * cell])
-        below = lows[None, :, :] - points[:, None, :]
-        above = points[:, None, :] - highs[None, :, :]
-        outside = np.maximum(np.maximum(below, above), 0.0)
-        distance = np.hypot(outside[..., 0], outside[..., 1])  # (points, boxes)
-        clearance = np.array([robot_radius + margins[i] for i in standing], dtype=np.float64)
-        every = distance - clearance[None, :]
-        # Only a box with a negative gap somewhere is on the path (b): one test for all.
-        touching = np.asarray((every < 0).any(axis=0))
-        for column, i in enumerate(standing):
-            gaps[i] = every[:, column] if touching[column] else None
+        count = len(points)
+        first = np.empty(len(standing), dtype=np.int64)
+        least = np.empty(len(standing), dtype=np.float64)
+        box_gaps(points, np.array([obstacles[i].cells for i in standing], dtype=np.int64),
+                 cell, np.array([robot_radius + margins[i] for i in standing],
+                                dtype=np.float64), first, least)
+        on_path = dict(zip(standing, zip(first.tolist(), least.tolist(), strict=True),
+                           strict=True))
     found = []
     for i, ob in enumerate(obstacles):
-        if i in gaps:
-            column_gaps = gaps[i]
-            a = (None if column_gaps is None else
-                 _on_the_path(robot, direction, speed, path_length, ob, column_gaps))
+        if i in on_path:
+            a = _on_the_path(robot, direction, speed, path_length, ob, *on_path[i], count)
         else:
             a = assess(robot, direction, speed, path_length, ob, robot_radius=robot_radius,
                        margin=margins[i], cell=cell, horizon=horizons[i],
@@ -256,7 +252,10 @@ def assess(
         lo, hi = cell_squares(obstacle.cells, cell)
         points = path_points(robot, direction, path_length, cell / 4)
         gaps = gap_to_boxes(points, lo[None, :], hi[None, :]) - (robot_radius + margin)
-        return _on_the_path(robot, direction, speed, path_length, obstacle, gaps)
+        negative = gaps < 0
+        first = int(np.argmax(negative)) if negative.any() else -1
+        return _on_the_path(robot, direction, speed, path_length, obstacle, first,
+                            float(gaps.min()), len(gaps))
 
     t_path = min(horizon, path_length / speed) if speed > 0 else horizon
     t_min, d_min = closest_approach(rel, w - direction * speed, t_path)
