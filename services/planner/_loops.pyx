@@ -221,3 +221,10 @@ def box_gaps(const double[:, ::1] points, const long[:, ::1] cells, double cell,
             smallest = min(smallest, gap)
         first[j] = hit
         least[j] = smallest
+
+
+def c_hypot(double x, double y):
+    """The C library's ``hypot``, the one numpy's ``np.hypot`` calls, for two Python
+    numbers without the cost of a numpy call (``math.hypot`` rounds its own way and
+    differs from it in the last bit at times)."""
+    return hypot(x, y)

@@ -1,15 +1,16 @@
-"""The compiled gap of path points to grid boxes (``_loops.box_gaps``, what
-``prediction.assess_all`` calls for the standing obstacles) gives, to the bit, what the
-numpy array operations it replaced give: for each box the first point with a negative
-gap and the smallest gap."""
+"""The collision prediction's faster arithmetic gives, to the bit, the numbers of the
+numpy code it replaced: the compiled gap of path points to grid boxes
+(``_loops.box_gaps``, what ``prediction.assess_all`` calls for the standing obstacles),
+the C library's ``hypot`` for two numbers (``_loops.c_hypot``) and the movers' dot
+products taken all at once (``prediction._row_dots``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from zenav.services.planner._loops import box_gaps
-from zenav.services.planner.prediction import path_points
+from zenav.services.planner._loops import box_gaps, c_hypot
+from zenav.services.planner.prediction import _row_dots, path_points
 
 
 def numpy_box_gaps(points: np.ndarray, cells: np.ndarray, cell: float,
@@ -62,3 +63,23 @@ def test_the_random_boxes_touch_and_miss() -> None:
     to be checked on both sides."""
     firsts = [f for seed in range(30) for f in numpy_box_gaps(*random_case(seed))[0]]
     assert sum(f >= 0 for f in firsts) > 10 and sum(f < 0 for f in firsts) > 10
+
+
+def test_c_hypot_is_numpys_hypot() -> None:
+    rng = np.random.default_rng(7)
+    xy = rng.normal(size=(20000, 2)) * rng.choice([1e-3, 1.0, 30.0], size=(20000, 1))
+    xy[:50, 1] = 0.0
+    got = np.array([c_hypot(x, y) for x, y in xy.tolist()])
+    assert got.tobytes() == np.hypot(xy[:, 0], xy[:, 1]).tobytes()
+    assert c_hypot(*xy[0]) == float(np.hypot(*xy[0]))  # and on numpy scalars
+
+
+@pytest.mark.parametrize("rows", [1, 2, 5, 20])
+def test_row_dots_are_the_dots_one_by_one(rows: int) -> None:
+    """Each is ``a[i] @ b`` to the bit (numpy may fuse a multiply and an add in its dot
+    product, so plain arithmetic on numbers would not do)."""
+    rng = np.random.default_rng(rows)
+    for _ in range(300):
+        a, b, one = rng.normal(size=(rows, 2)), rng.normal(size=(rows, 2)), rng.normal(size=2)
+        assert _row_dots(a, b) == [float(a[i] @ b[i]) for i in range(rows)]
+        assert _row_dots(a, one) == [float(a[i] @ one) for i in range(rows)]
