@@ -228,3 +228,44 @@ def c_hypot(double x, double y):
     numbers without the cost of a numpy call (``math.hypot`` rounds its own way and
     differs from it in the last bit at times)."""
     return hypot(x, y)
+
+
+@cython.cdivision(True)
+def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1] times,
+             const double[:, ::1] positions, const double[:, ::1] velocities,
+             const double[::1] radii, const double[::1] top_speeds, const double[::1] ages,
+             double robot_radius, double margin, double growth, double comfort, double tau,
+             double[:, ::1] worst, double[::1] first_t, long[::1] who):
+    """The passes of every roll-out (rows of ``xs``, ``ys``: positions at ``times``) by
+    every mover, as ``safety.contact_costs`` defines them: into ``worst`` (n, m) the
+    largest cost of a pass by each mover over the horizon, into ``first_t`` the time of
+    the roll-out's first contact (inf: none) and into ``who`` its mover (the first by
+    index at that time; -1: none). (``tau``, and ``comfort`` when above 0, are never 0:
+    ``Settings`` come from the planner's parameters.)"""
+    cdef Py_ssize_t n = xs.shape[0], m = radii.shape[0], steps = times.shape[0]
+    cdef Py_ssize_t i, j, k, first_k
+    cdef double px, py, gap, clearance, near, depth, cost, largest
+    for i in range(n):
+        first_k = steps
+        who[i] = -1
+        for j in range(m):
+            largest = -INFINITY
+            for k in range(steps):
+                px = positions[j, 0] + velocities[j, 0] * times[k]
+                py = positions[j, 1] + velocities[j, 1] * times[k]
+                clearance = (robot_radius + radii[j] + margin / 2
+                             + growth * top_speeds[j] * (ages[j] + times[k]))
+                gap = hypot(xs[i, k] - px, ys[i, k] - py) - clearance
+                if gap < 0.0:
+                    depth = min(max(-gap / clearance, 0.0), 1.0)
+                    cost = 10.0 * (1.0 + depth)
+                    if k < first_k:
+                        first_k = k
+                        who[i] = j
+                elif comfort > 0:
+                    cost = min(max(1.0 - gap / comfort, 0.0), 1.0)
+                else:
+                    cost = 0.0
+                largest = max(largest, cost * (1.0 / (1.0 + times[k] / tau)))
+            worst[i, j] = largest
+        first_t[i] = times[first_k] if first_k < steps else INFINITY
