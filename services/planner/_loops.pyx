@@ -3,18 +3,20 @@
 
 numpy ran these as one pass over whole arrays per step, which costs more in call
 overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
-over the map, about 41,000 samples a scan in the perf world, and the marking) and the
-unicycle roll-out of every safety candidate over the horizon. Here they are plain loops
-with the same floating-point operations, in the same order, as the numpy code they
-replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors of the cell
-indices as numpy has them), so the results are the same to the bit. The Python callers
-(``costmap.py``, ``safety.py``) own the meaning; ``_loops.pyi`` gives their types.
+over the map, about 41,000 samples a scan in the perf world, and the marking), the
+unicycle roll-out of every safety candidate over the horizon, and the collision
+prediction's gaps between the path and each standing obstacle's grid area. Here they
+are plain loops with the same floating-point operations, in the same order, as the
+numpy code they replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors
+of the cell indices as numpy has them), so the results are the same to the bit. The
+Python callers (``costmap.py``, ``safety.py``, ``prediction.py``) own the meaning;
+``_loops.pyi`` gives their types.
 """
 
 import numpy as np
 
 cimport cython
-from libc.math cimport cos, hypot, sin, sqrt
+from libc.math cimport INFINITY, cos, hypot, sin, sqrt
 
 include "../_angles.pxi"
 
@@ -192,3 +194,78 @@ def drive(const double[::1] headings, const double[::1] speeds, double dt, doubl
             y = y + v * sin(theta) * dt
             xs[i, k] = x
             ys[i, k] = y
+
+
+def box_gaps(const double[:, ::1] points, const long[:, ::1] cells, double cell,
+             const double[::1] clearances, long[::1] first, double[::1] least):
+    """For each grid box j (row ix_min, ix_max, iy_min, iy_max of ``cells``; cell i
+    spans [(i - 1/2) cell, (i + 1/2) cell]) the gap of every point (n, 2) to it, as
+    ``prediction.assess`` measures it: ``hypot`` of how far the point is outside the box
+    along each axis, less ``clearances[j]``. Into ``first[j]`` the index of the first
+    point with a negative gap (-1: none), into ``least[j]`` the smallest gap."""
+    cdef double lo_x, lo_y, hi_x, hi_y, out_x, out_y, gap, smallest
+    cdef Py_ssize_t i, j, hit
+    for j in range(cells.shape[0]):
+        lo_x = (<double>cells[j, 0] - 0.5) * cell
+        hi_x = (<double>cells[j, 1] + 0.5) * cell
+        lo_y = (<double>cells[j, 2] - 0.5) * cell
+        hi_y = (<double>cells[j, 3] + 0.5) * cell
+        hit = -1
+        smallest = INFINITY
+        for i in range(points.shape[0]):
+            out_x = max(max(lo_x - points[i, 0], points[i, 0] - hi_x), 0.0)
+            out_y = max(max(lo_y - points[i, 1], points[i, 1] - hi_y), 0.0)
+            gap = hypot(out_x, out_y) - clearances[j]
+            if gap < 0.0 and hit < 0:
+                hit = i
+            smallest = min(smallest, gap)
+        first[j] = hit
+        least[j] = smallest
+
+
+def c_hypot(double x, double y):
+    """The C library's ``hypot``, the one numpy's ``np.hypot`` calls, for two Python
+    numbers without the cost of a numpy call (``math.hypot`` rounds its own way and
+    differs from it in the last bit at times)."""
+    return hypot(x, y)
+
+
+@cython.cdivision(True)
+def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1] times,
+             const double[:, ::1] positions, const double[:, ::1] velocities,
+             const double[::1] radii, const double[::1] top_speeds, const double[::1] ages,
+             double robot_radius, double margin, double growth, double comfort, double tau,
+             double[:, ::1] worst, double[::1] first_t, long[::1] who):
+    """The passes of every roll-out (rows of ``xs``, ``ys``: positions at ``times``) by
+    every mover, as ``safety.contact_costs`` defines them: into ``worst`` (n, m) the
+    largest cost of a pass by each mover over the horizon, into ``first_t`` the time of
+    the roll-out's first contact (inf: none) and into ``who`` its mover (the first by
+    index at that time; -1: none). (``tau``, and ``comfort`` when above 0, are never 0:
+    ``Settings`` come from the planner's parameters.)"""
+    cdef Py_ssize_t n = xs.shape[0], m = radii.shape[0], steps = times.shape[0]
+    cdef Py_ssize_t i, j, k, first_k
+    cdef double px, py, gap, clearance, near, depth, cost, largest
+    for i in range(n):
+        first_k = steps
+        who[i] = -1
+        for j in range(m):
+            largest = -INFINITY
+            for k in range(steps):
+                px = positions[j, 0] + velocities[j, 0] * times[k]
+                py = positions[j, 1] + velocities[j, 1] * times[k]
+                clearance = (robot_radius + radii[j] + margin / 2
+                             + growth * top_speeds[j] * (ages[j] + times[k]))
+                gap = hypot(xs[i, k] - px, ys[i, k] - py) - clearance
+                if gap < 0.0:
+                    depth = min(max(-gap / clearance, 0.0), 1.0)
+                    cost = 10.0 * (1.0 + depth)
+                    if k < first_k:
+                        first_k = k
+                        who[i] = j
+                elif comfort > 0:
+                    cost = min(max(1.0 - gap / comfort, 0.0), 1.0)
+                else:
+                    cost = 0.0
+                largest = max(largest, cost * (1.0 / (1.0 + times[k] / tau)))
+            worst[i, j] = largest
+        first_t[i] = times[first_k] if first_k < steps else INFINITY

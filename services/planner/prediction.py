@@ -34,6 +34,7 @@ When a crosser is a threat (e) is the planner's ``meet_rule``:
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -41,11 +42,13 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import ObstacleKind, ScenarioLetter
+from zenav.services.planner._loops import box_gaps, c_hypot
 
 MeetRule = Literal["closest", "same_time"]
 """How a crosser is found to meet the robot (e); see the module notes."""
 
 Vec = npt.NDArray[np.float64]
+Point = tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -79,9 +82,16 @@ class Assessment:
 
 def closest_approach(rel_pos: Vec, rel_vel: Vec, t_max: float) -> tuple[float, float]:
     """(time, distance) of the smallest |rel_pos + rel_vel t| for t in [0, t_max]."""
-    speed2 = float(rel_vel @ rel_vel)
-    t = 0.0 if speed2 < 1e-12 else min(max(-float(rel_pos @ rel_vel) / speed2, 0.0), t_max)
-    return t, float(np.hypot(*(rel_pos + rel_vel * t)))
+    return _closest_approach(rel_pos.tolist(), rel_vel.tolist(), float(rel_vel @ rel_vel),
+                             float(rel_pos @ rel_vel), t_max)
+
+
+def _closest_approach(rel_pos: Sequence[float], rel_vel: Sequence[float], speed2: float,
+                      toward: float, t_max: float) -> tuple[float, float]:
+    """:func:`closest_approach` from the two vectors as numbers and the dot products
+    ``rel_vel . rel_vel`` and ``rel_pos . rel_vel``."""
+    t = 0.0 if speed2 < 1e-12 else min(max(-toward / speed2, 0.0), t_max)
+    return t, c_hypot(rel_pos[0] + rel_vel[0] * t, rel_pos[1] + rel_vel[1] * t)
 
 
 def at_the_pcp_together(robot_distance: float, obstacle_distance: float, robot_speed: float,
@@ -130,35 +140,89 @@ def path_points(start: Vec, direction: Vec, length: float, step: float) -> Vec:
     return start[None, :] + s[:, None] * direction[None, :]
 
 
-def line_crossing(p: Vec, d: Vec, c: Vec, u: Vec) -> tuple[float, float] | None:
-    """(s, q) with p + d s = c + u q for unit directions d, u; None when parallel."""
+def line_crossing(d: Point, rel: Point, u: Point) -> tuple[float, float] | None:
+    """(s, q) with d s = rel + u q for unit directions d, u: where the line from a point
+    along ``d`` crosses the line along ``u`` from ``rel`` (relative to that point); None
+    when parallel."""
     det = d[0] * (-u[1]) + u[0] * d[1]
     if abs(det) < 1e-9:
         return None
-    rhs = c - p
-    s = (rhs[0] * (-u[1]) + u[0] * rhs[1]) / det
-    q = (d[0] * rhs[1] - d[1] * rhs[0]) / det
-    return float(s), float(q)
+    s = (rel[0] * (-u[1]) + u[0] * rel[1]) / det
+    q = (d[0] * rel[1] - d[1] * rel[0]) / det
+    return s, q
 
 
 def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
-                 obstacle: Obstacle, gaps: Vec) -> Assessment | None:
+                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment | None:
     """(b) for a standing obstacle, from the gaps (m, clearance taken off) between its grid
-    area and each of the points along the path; None when none is negative."""
-    first = int(np.argmax(gaps < 0)) if (gaps < 0).any() else -1
+    area and each of the ``count`` points along the path: ``first``, the index of the
+    first negative one (-1: none, then None), and ``least``, the smallest."""
     if first < 0:
         return None
     along = float((np.asarray(obstacle.position, dtype=np.float64) - robot) @ direction)
-    s_hit = first * path_length / (len(gaps) - 1)
+    s_hit = first * path_length / (count - 1)
     centre_s = min(max(along, 0.0), path_length)
-    pcp = robot + direction * centre_s
-    return Assessment(obstacle, "b", True, (float(pcp[0]), float(pcp[1])), s_hit,
-                      s_hit / speed if speed > 0 else math.inf, math.inf,
-                      float(gaps.min()), along, 0.0, (float(direction[0]), float(direction[1])))
+    rx, ry = robot.tolist()
+    dx, dy = direction.tolist()
+    return Assessment(obstacle, "b", True, (rx + dx * centre_s, ry + dy * centre_s), s_hit,
+                      s_hit / speed if speed > 0 else math.inf, math.inf, least, along, 0.0,
+                      (dx, dy))
 
 
 def _moving(obstacle: Obstacle, moving_speed: float) -> bool:
-    return obstacle.kind == "dynamic" and float(np.hypot(*obstacle.velocity)) >= moving_speed
+    return obstacle.kind == "dynamic" and c_hypot(*obstacle.velocity) >= moving_speed
+
+
+def _row_dots(a: Vec, b: Vec) -> list[float]:
+    """The dot product of each row of ``a`` (n, 2) with ``b``, one row (2,) for all or one
+    per row (n, 2). numpy takes each by the routine ``a[i] @ b`` uses (BLAS's, which may
+    fuse the multiply and add), so the numbers are those to the bit."""
+    return list((a[:, None, :] @ b[..., :, None])[:, 0, 0].tolist())
+
+
+def _mover(robot: Point, heading: Point, speed: float, path_length: float,
+           obstacle: Obstacle, rel: Point, along: float, along_speed: float,
+           obstacle_speed: float, closest: tuple[float, float], clearance: float, *,
+           head_on_cos: float, same_way_cos: float, meet_rule: MeetRule,
+           following: bool) -> Assessment | None:
+    """(c) to (g) for a moving obstacle, from its numbers: ``rel`` its centre from the
+    robot, ``along`` and ``along_speed`` the components of that and of its velocity
+    along the robot's path (``heading``, unit), its speed, and the (time, distance) of
+    the closest approach of the two centres; see :func:`assess`."""
+    t_min, d_min = closest
+    threat = d_min < clearance
+    gap = d_min - clearance
+    cos_phi = along_speed / obstacle_speed
+    (rx, ry), (dx, dy) = robot, heading
+
+    if following and cos_phi >= same_way_cos and along > 0:
+        threat = threat or abs(rel[0] * dy - rel[1] * dx) < clearance
+    if cos_phi <= head_on_cos or cos_phi >= same_way_cos:
+        if not threat or along <= 0:
+            return None
+        letter: ScenarioLetter = "f" if cos_phi <= head_on_cos else "g"
+        return Assessment(obstacle, letter, True,
+                          (rx + dx * speed * t_min, ry + dy * speed * t_min),
+                          speed * t_min, t_min, t_min, gap, along, along_speed, heading)
+
+    vx, vy = obstacle.velocity
+    crossing = line_crossing(heading, rel, (vx / obstacle_speed, vy / obstacle_speed))
+    if crossing is None:
+        return None
+    s, q = crossing
+    robot_time = s / speed if speed > 0 else math.inf
+    obstacle_time = q / obstacle_speed
+    pcp_xy = (rx + dx * s, ry + dy * s)
+    if meet_rule == "same_time":
+        threat = at_the_pcp_together(s, q, speed, obstacle_speed, clearance, path_length)
+    if threat:
+        return Assessment(obstacle, "e", True, pcp_xy, s, robot_time, obstacle_time, gap, along,
+                          along_speed, heading)
+    if s <= 0 or s > path_length + clearance or q < -clearance:
+        return None  # the paths cross behind the robot, beyond its path, or already behind
+    passing: ScenarioLetter = "c" if obstacle_time < robot_time else "d"
+    return Assessment(obstacle, passing, False, pcp_xy, s, robot_time, obstacle_time, gap, along,
+                      along_speed, heading)
 
 
 def assess_all(
@@ -179,42 +243,45 @@ def assess_all(
     meet_rule: MeetRule,
 ) -> list[Assessment]:
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
-    per obstacle), the ones with something to do with the path, in order. The standing
+    per obstacle), the ones with something to do with the path, in order, by the same
+    arithmetic as :func:`assess`, so the same answers to the last bit. The standing
     obstacles are measured against the path all at once: one set of path points, every
-    grid area's gaps in one array operation (element by element the same arithmetic as
-    :func:`assess`, so the same answers to the last bit)."""
+    grid area's gaps in one compiled loop (``_loops.box_gaps``). The movers' vectors are
+    arrays of all of them, their dot products taken in one call each; the rest is
+    arithmetic on plain numbers, mover by mover."""
     standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
-    gaps: dict[int, Vec | None] = {}  # standing obstacles' gaps; None: clear of the path
+    found: dict[int, Assessment | None] = {}
     if standing:
         points = path_points(robot, direction, path_length, cell / 4)
-        cells = np.array([obstacles[i].cells for i in standing], dtype=np.float64)
-        lows = np.column_stack([(cells[:, 0] - 0.5) * cell, (cells[:, 2] - 0.5) * cell])
-        highs = np.column_stack([(cells[:, 1] + 0.5) * cell, (cells[:, 3] + 0.5) * cell])
-        below = lows[None, :, :] - points[:, None, :]
-        above = points[:, None, :] - highs[None, :, :]
-        outside = np.maximum(np.maximum(below, above), 0.0)
-        distance = np.hypot(outside[..., 0], outside[..., 1])  # (points, boxes)
-        clearance = np.array([robot_radius + margins[i] for i in standing], dtype=np.float64)
-        every = distance - clearance[None, :]
-        # Only a box with a negative gap somewhere is on the path (b): one test for all.
-        touching = np.asarray((every < 0).any(axis=0))
-        for column, i in enumerate(standing):
-            gaps[i] = every[:, column] if touching[column] else None
-    found = []
-    for i, ob in enumerate(obstacles):
-        if i in gaps:
-            column_gaps = gaps[i]
-            a = (None if column_gaps is None else
-                 _on_the_path(robot, direction, speed, path_length, ob, column_gaps))
-        else:
-            a = assess(robot, direction, speed, path_length, ob, robot_radius=robot_radius,
-                       margin=margins[i], cell=cell, horizon=horizons[i],
-                       moving_speed=moving_speed, head_on_cos=head_on_cos,
-                       same_way_cos=same_way_cos, meet_rule=meet_rule,
-                       following=following[i])
-        if a is not None:
-            found.append(a)
-    return found
+        first = np.empty(len(standing), dtype=np.int64)
+        least = np.empty(len(standing), dtype=np.float64)
+        box_gaps(points, np.array([obstacles[i].cells for i in standing], dtype=np.int64),
+                 cell, np.array([robot_radius + margins[i] for i in standing],
+                                dtype=np.float64), first, least)
+        for i, hit, smallest in zip(standing, first.tolist(), least.tolist(), strict=True):
+            found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i], hit,
+                                    smallest, len(points))
+    moving = [i for i in range(len(obstacles)) if i not in found]
+    if moving:
+        # The movers' vectors as arrays, their dot products all at once, the rest per mover.
+        rel = np.array([obstacles[i].position for i in moving], dtype=np.float64) - robot
+        velocity = np.array([obstacles[i].velocity for i in moving], dtype=np.float64)
+        rel_vel = velocity - direction * speed
+        along, along_speed = _row_dots(rel, direction), _row_dots(velocity, direction)
+        speed2, toward = _row_dots(rel_vel, rel_vel), _row_dots(rel, rel_vel)
+        robot_xy = (float(robot[0]), float(robot[1]))
+        heading = (float(direction[0]), float(direction[1]))
+        for k, (i, (rx, ry), relative_velocity) in enumerate(
+                zip(moving, rel.tolist(), rel_vel.tolist(), strict=True)):
+            ob = obstacles[i]
+            t_path = min(horizons[i], path_length / speed) if speed > 0 else horizons[i]
+            found[i] = _mover(
+                robot_xy, heading, speed, path_length, ob, (rx, ry), along[k], along_speed[k],
+                c_hypot(*ob.velocity),
+                _closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
+                robot_radius + ob.radius + margins[i], head_on_cos=head_on_cos,
+                same_way_cos=same_way_cos, meet_rule=meet_rule, following=following[i])
+    return [a for i in range(len(obstacles)) if (a := found[i]) is not None]
 
 
 def assess(
@@ -256,41 +323,15 @@ def assess(
         lo, hi = cell_squares(obstacle.cells, cell)
         points = path_points(robot, direction, path_length, cell / 4)
         gaps = gap_to_boxes(points, lo[None, :], hi[None, :]) - (robot_radius + margin)
-        return _on_the_path(robot, direction, speed, path_length, obstacle, gaps)
+        negative = gaps < 0
+        first = int(np.argmax(negative)) if negative.any() else -1
+        return _on_the_path(robot, direction, speed, path_length, obstacle, first,
+                            float(gaps.min()), len(gaps))
 
+    # (c) to (g): where would the two meet, if anywhere?
     t_path = min(horizon, path_length / speed) if speed > 0 else horizon
-    t_min, d_min = closest_approach(rel, w - direction * speed, t_path)
-    threat = d_min < clearance
-    gap = d_min - clearance
-    along_speed = float(w @ direction)
-    cos_phi = along_speed / obstacle_speed
-    u = w / obstacle_speed
-
-    if following and cos_phi >= same_way_cos and along > 0:
-        threat = threat or abs(float(rel[0] * direction[1] - rel[1] * direction[0])) < clearance
-    if cos_phi <= head_on_cos or cos_phi >= same_way_cos:
-        if not threat or along <= 0:
-            return None
-        letter: ScenarioLetter = "f" if cos_phi <= head_on_cos else "g"
-        meet = robot + direction * speed * t_min
-        return Assessment(obstacle, letter, True, (float(meet[0]), float(meet[1])),
-                          speed * t_min, t_min, t_min, gap, along, along_speed, heading)
-
-    crossing = line_crossing(robot, direction, c, u)
-    if crossing is None:
-        return None
-    s, q = crossing
-    pcp = robot + direction * s
-    robot_time = s / speed if speed > 0 else math.inf
-    obstacle_time = q / obstacle_speed
-    pcp_xy = (float(pcp[0]), float(pcp[1]))
-    if meet_rule == "same_time":
-        threat = at_the_pcp_together(s, q, speed, obstacle_speed, clearance, path_length)
-    if threat:
-        return Assessment(obstacle, "e", True, pcp_xy, s, robot_time, obstacle_time, gap, along,
-                          along_speed, heading)
-    if s <= 0 or s > path_length + clearance or q < -clearance:
-        return None  # the paths cross behind the robot, beyond its path, or already behind
-    passing: ScenarioLetter = "c" if obstacle_time < robot_time else "d"
-    return Assessment(obstacle, passing, False, pcp_xy, s, robot_time, obstacle_time, gap, along,
-                      along_speed, heading)
+    return _mover((float(robot[0]), float(robot[1])), heading, speed, path_length, obstacle,
+                  (float(rel[0]), float(rel[1])), along, float(w @ direction), obstacle_speed,
+                  closest_approach(rel, w - direction * speed, t_path), clearance,
+                  head_on_cos=head_on_cos, same_way_cos=same_way_cos, meet_rule=meet_rule,
+                  following=following)

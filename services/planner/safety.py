@@ -46,7 +46,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.services.geometry import wrap_angle, wrap_angles
-from zenav.services.planner._loops import drive
+from zenav.services.planner._loops import contacts, drive
 
 Vec = npt.NDArray[np.float64]
 
@@ -120,30 +120,33 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
 def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,
                   s: Settings) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
     """Per roll-out: the cost of its passes by the movers, the time of its first contact
-    (inf: none) and the mover of that contact (-1: none)."""
-    n = xs.shape[0]
-    if len(movers) == 0:
+    (inf: none) and the mover of that contact (-1: none).
+
+    Mover j is predicted at ``positions[j] + velocities[j] t``; the robot at step t is in
+    contact with it when their centres are less than the clearance apart: robot radius
+    + mover radius + half the margin + growth x its top speed x (its age + t). A contact
+    costs 10 (1 + depth), its depth the gap below the clearance over the clearance (0 at
+    its edge, 1 on the predicted centre, at most 1); a pass within ``comfort`` beyond it
+    costs 1 - gap / comfort. Each cost is weighted 1 / (1 + t / tau); a roll-out pays
+    the largest weighted cost of each mover over the horizon, summed over the movers.
+    The loop over roll-outs, movers and steps is compiled (``_loops.contacts``)."""
+    n, m = xs.shape[0], len(movers)
+    if m == 0:
         return np.zeros(n), np.full(n, math.inf), np.full(n, -1, dtype=np.int64)
-    px = movers.positions[:, 0, None] + movers.velocities[:, 0, None] * times  # (m, k)
-    py = movers.positions[:, 1, None] + movers.velocities[:, 1, None] * times
-    gap = np.hypot(xs[:, None, :] - px[None], ys[:, None, :] - py[None])  # (n, m, k)
-    ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
-    clearance = (robot_radius + movers.radii[:, None] + s.margin / 2
-                 + s.growth * movers.top_speeds[:, None] * (ages[:, None] + times))
-    gap -= clearance[None]
-    weight = 1.0 / (1.0 + times / s.tau)
-    touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
-    near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
-    # How deep a contact goes: 0 at the clearance's edge, 1 on the mover's predicted centre.
-    depth = np.clip(-gap / clearance[None], 0.0, 1.0)
-    cost_mk = np.where(touch, 10.0 * (1.0 + depth), near) * weight  # (n, m, k)
-    cost = cost_mk.max(axis=2).sum(axis=1)
-    any_touch: npt.NDArray[np.bool_] = np.any(touch, axis=1)  # (n, k)
-    first_k = np.where(np.any(any_touch, axis=1), np.argmax(any_touch, axis=1), -1)
-    first_t = np.where(first_k >= 0, times[np.maximum(first_k, 0)], math.inf)
-    who = np.where(first_k >= 0,
-                   touch[np.arange(n), :, np.maximum(first_k, 0)].argmax(axis=1), -1)
-    return cost, first_t, who.astype(np.int64)
+    worst = np.empty((n, m))  # the largest weighted cost of each mover, per roll-out
+    first_t = np.empty(n)
+    who = np.empty(n, dtype=np.int64)
+    contacts(np.ascontiguousarray(xs, dtype=np.float64),
+             np.ascontiguousarray(ys, dtype=np.float64),
+             np.ascontiguousarray(times, dtype=np.float64),
+             np.ascontiguousarray(movers.positions, dtype=np.float64),
+             np.ascontiguousarray(movers.velocities, dtype=np.float64),
+             np.ascontiguousarray(movers.radii, dtype=np.float64),
+             np.ascontiguousarray(movers.top_speeds, dtype=np.float64),
+             np.zeros(m) if movers.ages is None
+             else np.ascontiguousarray(movers.ages, dtype=np.float64),
+             robot_radius, s.margin, s.growth, s.comfort, s.tau, worst, first_t, who)
+    return worst.sum(axis=1), first_t, who
 
 
 def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: Vec,

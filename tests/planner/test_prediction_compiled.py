@@ -1,0 +1,85 @@
+"""The collision prediction's faster arithmetic gives, to the bit, the numbers of the
+numpy code it replaced: the compiled gap of path points to grid boxes
+(``_loops.box_gaps``, what ``prediction.assess_all`` calls for the standing obstacles),
+the C library's ``hypot`` for two numbers (``_loops.c_hypot``) and the movers' dot
+products taken all at once (``prediction._row_dots``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from zenav.services.planner._loops import box_gaps, c_hypot
+from zenav.services.planner.prediction import _row_dots, path_points
+
+
+def numpy_box_gaps(points: np.ndarray, cells: np.ndarray, cell: float,
+                   clearances: np.ndarray) -> tuple[list[int], list[float]]:
+    """The gaps as numpy array operations (the code ``box_gaps`` replaced)."""
+    boxes = cells.astype(np.float64)
+    lows = np.column_stack([(boxes[:, 0] - 0.5) * cell, (boxes[:, 2] - 0.5) * cell])
+    highs = np.column_stack([(boxes[:, 1] + 0.5) * cell, (boxes[:, 3] + 0.5) * cell])
+    below = lows[None, :, :] - points[:, None, :]
+    above = points[:, None, :] - highs[None, :, :]
+    outside = np.maximum(np.maximum(below, above), 0.0)
+    every = np.hypot(outside[..., 0], outside[..., 1]) - clearances[None, :]
+    negative = every < 0
+    first = [int(np.argmax(negative[:, j])) if negative[:, j].any() else -1
+             for j in range(len(cells))]
+    return first, every.min(axis=0).tolist()
+
+
+Case = tuple[np.ndarray, np.ndarray, float, np.ndarray]
+
+
+def random_case(seed: int) -> Case:
+    """Points along a random path, random grid boxes round it and their clearances."""
+    rng = np.random.default_rng(seed)
+    cell = float(rng.choice([0.05, 0.1, 0.25]))
+    heading = rng.uniform(-np.pi, np.pi)
+    points = path_points(rng.uniform(-2.0, 2.0, 2), np.array([np.cos(heading), np.sin(heading)]),
+                         rng.uniform(0.1, 6.0), cell / 4)
+    count = int(rng.integers(1, 25))
+    lows = np.column_stack([rng.integers(-60, 60, count), rng.integers(-60, 60, count)])
+    sizes = rng.integers(0, 6, (count, 2))
+    cells = np.column_stack([lows[:, 0], lows[:, 0] + sizes[:, 0],
+                             lows[:, 1], lows[:, 1] + sizes[:, 1]]).astype(np.int64)
+    return points, cells, cell, rng.uniform(0.2, 1.5, count)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_box_gaps_is_the_numpy_arithmetic(seed: int) -> None:
+    points, cells, cell, clearances = random_case(seed)
+    first = np.empty(len(cells), dtype=np.int64)
+    least = np.empty(len(cells), dtype=np.float64)
+    box_gaps(points, cells, cell, clearances, first, least)
+    want_first, want_least = numpy_box_gaps(points, cells, cell, clearances)
+    assert first.tolist() == want_first
+    assert least.tobytes() == np.array(want_least, dtype=np.float64).tobytes()
+
+
+def test_the_random_boxes_touch_and_miss() -> None:
+    """The cases above have boxes on the path and boxes clear of it, for the arithmetic
+    to be checked on both sides."""
+    firsts = [f for seed in range(30) for f in numpy_box_gaps(*random_case(seed))[0]]
+    assert sum(f >= 0 for f in firsts) > 10 and sum(f < 0 for f in firsts) > 10
+
+
+def test_c_hypot_is_numpys_hypot() -> None:
+    rng = np.random.default_rng(7)
+    xy = rng.normal(size=(20000, 2)) * rng.choice([1e-3, 1.0, 30.0], size=(20000, 1))
+    xy[:50, 1] = 0.0
+    got = np.array([c_hypot(x, y) for x, y in xy.tolist()])
+    assert got.tobytes() == np.hypot(xy[:, 0], xy[:, 1]).tobytes()
+    assert c_hypot(*xy[0]) == float(np.hypot(*xy[0]))  # and on numpy scalars
+
+
+@pytest.mark.parametrize("rows", [1, 2, 5, 20])
+def test_row_dots_are_the_dots_one_by_one(rows: int) -> None:
+    """Each is ``a[i] @ b`` to the bit (numpy may fuse a multiply and an add in its dot
+    product, so plain arithmetic on numbers would not do)."""
+    rng = np.random.default_rng(rows)
+    for _ in range(300):
+        a, b, one = rng.normal(size=(rows, 2)), rng.normal(size=(rows, 2)), rng.normal(size=2)
+        assert _row_dots(a, b) == [float(a[i] @ b[i]) for i in range(rows)]
+        assert _row_dots(a, one) == [float(a[i] @ one) for i in range(rows)]
