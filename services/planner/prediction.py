@@ -80,16 +80,11 @@ class Assessment:
     direction: tuple[float, float]  # the robot's path, unit vector
 
 
-def closest_approach(rel_pos: Vec, rel_vel: Vec, t_max: float) -> tuple[float, float]:
-    """(time, distance) of the smallest |rel_pos + rel_vel t| for t in [0, t_max]."""
-    return _closest_approach(rel_pos.tolist(), rel_vel.tolist(), float(rel_vel @ rel_vel),
-                             float(rel_pos @ rel_vel), t_max)
-
-
-def _closest_approach(rel_pos: Sequence[float], rel_vel: Sequence[float], speed2: float,
-                      toward: float, t_max: float) -> tuple[float, float]:
-    """:func:`closest_approach` from the two vectors as numbers and the dot products
-    ``rel_vel . rel_vel`` and ``rel_pos . rel_vel``."""
+def closest_approach(rel_pos: Sequence[float], rel_vel: Sequence[float], speed2: float,
+                     toward: float, t_max: float) -> tuple[float, float]:
+    """(time, distance) of the smallest |rel_pos + rel_vel t| for t in [0, t_max], from
+    the two vectors as numbers and the dot products ``speed2`` = rel_vel . rel_vel and
+    ``toward`` = rel_pos . rel_vel."""
     t = 0.0 if speed2 < 1e-12 else min(max(-toward / speed2, 0.0), t_max)
     return t, c_hypot(rel_pos[0] + rel_vel[0] * t, rel_pos[1] + rel_vel[1] * t)
 
@@ -243,8 +238,8 @@ def assess_all(
     meet_rule: MeetRule,
 ) -> list[Assessment]:
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
-    per obstacle), the ones with something to do with the path, in order, by the same
-    arithmetic as :func:`assess`, so the same answers to the last bit. The standing
+    per obstacle), the ones with something to do with the path, in order (``assess`` is
+    this for one obstacle; each answer is the one it gets alone, to the last bit). The standing
     obstacles are measured against the path all at once: one set of path points, every
     grid area's gaps in one compiled loop (``_loops.box_gaps``). The movers' vectors are
     arrays of all of them, their dot products taken in one call each; the rest is
@@ -278,7 +273,7 @@ def assess_all(
             found[i] = _mover(
                 robot_xy, heading, speed, path_length, ob, (rx, ry), along[k], along_speed[k],
                 c_hypot(*ob.velocity),
-                _closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
+                closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
                 robot_radius + ob.radius + margins[i], head_on_cos=head_on_cos,
                 same_way_cos=same_way_cos, meet_rule=meet_rule, following=following[i])
     return [a for i in range(len(obstacles)) if (a := found[i]) is not None]
@@ -309,29 +304,8 @@ def assess(
 
     ``following``: the robot already follows this obstacle (g); it stays a threat while
     it is ahead in the robot's lane, however slowly the robot now closes in."""
-    c = np.asarray(obstacle.position, dtype=np.float64)
-    w = np.asarray(obstacle.velocity, dtype=np.float64)
-    rel = c - robot
-    along = float(rel @ direction)
-    heading = (float(direction[0]), float(direction[1]))
-    obstacle_speed = float(np.hypot(*w))
-    clearance = robot_radius + obstacle.radius + margin
-    moving = obstacle.kind == "dynamic" and obstacle_speed >= moving_speed
-
-    if not moving:
-        # (b): does the path come within the clearance of the obstacle's grid area S_k?
-        lo, hi = cell_squares(obstacle.cells, cell)
-        points = path_points(robot, direction, path_length, cell / 4)
-        gaps = gap_to_boxes(points, lo[None, :], hi[None, :]) - (robot_radius + margin)
-        negative = gaps < 0
-        first = int(np.argmax(negative)) if negative.any() else -1
-        return _on_the_path(robot, direction, speed, path_length, obstacle, first,
-                            float(gaps.min()), len(gaps))
-
-    # (c) to (g): where would the two meet, if anywhere?
-    t_path = min(horizon, path_length / speed) if speed > 0 else horizon
-    return _mover((float(robot[0]), float(robot[1])), heading, speed, path_length, obstacle,
-                  (float(rel[0]), float(rel[1])), along, float(w @ direction), obstacle_speed,
-                  closest_approach(rel, w - direction * speed, t_path), clearance,
-                  head_on_cos=head_on_cos, same_way_cos=same_way_cos, meet_rule=meet_rule,
-                  following=following)
+    found = assess_all(robot, direction, speed, path_length, [obstacle], [margin], [horizon],
+                       [following], robot_radius=robot_radius, cell=cell,
+                       moving_speed=moving_speed, head_on_cos=head_on_cos,
+                       same_way_cos=same_way_cos, meet_rule=meet_rule)
+    return found[0] if found else None
