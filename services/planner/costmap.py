@@ -45,6 +45,7 @@ from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
+    line_any,
     look_up,
     return_bounds,
     stamp_discs,
@@ -341,6 +342,18 @@ class Costmap:
         ``outside`` (free by default: the local checks near the robot, which the grid
         always holds with room to spare; the global path passes True)."""
         return self._look_up(points, self.blocked(), outside)
+
+    def blocked_along(self, start: tuple[float, float], direction: tuple[float, float],
+                      length: float, count: int) -> bool:
+        """Whether any of ``count`` points evenly spaced along the straight way from
+        ``start`` along ``direction`` (unit) for ``length`` m, both ends included (the
+        points of ``prediction.path_points``), lies in a blocked cell (beyond the grid:
+        free, as for ``blocked_at``); in compiled code (``_loops.line_any``), stopping at
+        the first."""
+        grid = self.blocked()
+        return line_any(start[0], start[1], direction[0], direction[1], length, count,
+                        float(self.origin[0]), float(self.origin[1]), self.resolution,
+                        _flat(grid).view(np.uint8), self.shape[1], False)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
         return self._look_up(points, self._refresh()[0], False)

@@ -128,10 +128,15 @@ def gap_to_boxes(points: Vec, lows: Vec, highs: Vec) -> Vec:
     return np.asarray(np.hypot(outside[..., 0], outside[..., 1]).min(axis=1), dtype=np.float64)
 
 
+def path_count(length: float, step: float) -> int:
+    """How many points :func:`path_points` puts along ``length`` m every ``step`` m."""
+    return max(2, math.ceil(length / step) + 1)
+
+
 def path_points(start: Vec, direction: Vec, length: float, step: float) -> Vec:
-    """Points every ``step`` m along a straight path, both ends included."""
-    count = max(2, math.ceil(length / step) + 1)
-    s = np.linspace(0.0, length, count)
+    """Points every ``step`` m along a straight path, both ends included. (The compiled
+    loops ``_loops.box_gaps`` and ``_loops.line_any`` make the same points themselves.)"""
+    s = np.linspace(0.0, length, path_count(length, step))
     return start[None, :] + s[:, None] * direction[None, :]
 
 
@@ -240,22 +245,25 @@ def assess_all(
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
     per obstacle), the ones with something to do with the path, in order (``assess`` is
     this for one obstacle; each answer is the one it gets alone, to the last bit). The standing
-    obstacles are measured against the path all at once: one set of path points, every
-    grid area's gaps in one compiled loop (``_loops.box_gaps``). The movers' vectors are
+    obstacles are measured against the path all at once: the path's points
+    (:func:`path_points`) and every grid area's gaps in one compiled loop
+    (``_loops.box_gaps``). The movers' vectors are
     arrays of all of them, their dot products taken in one call each; the rest is
     arithmetic on plain numbers, mover by mover."""
     standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
     found: dict[int, Assessment | None] = {}
     if standing:
-        points = path_points(robot, direction, path_length, cell / 4)
+        count = path_count(path_length, cell / 4)
         first = np.empty(len(standing), dtype=np.int64)
         least = np.empty(len(standing), dtype=np.float64)
-        box_gaps(points, np.array([obstacles[i].cells for i in standing], dtype=np.int64),
-                 cell, np.array([robot_radius + margins[i] for i in standing],
-                                dtype=np.float64), first, least)
+        box_gaps(float(robot[0]), float(robot[1]), float(direction[0]), float(direction[1]),
+                 path_length, count,
+                 np.array([obstacles[i].cells for i in standing], dtype=np.int64), cell,
+                 np.array([robot_radius + margins[i] for i in standing], dtype=np.float64),
+                 first, least)
         for i, hit, smallest in zip(standing, first.tolist(), least.tolist(), strict=True):
             found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i], hit,
-                                    smallest, len(points))
+                                    smallest, count)
     moving = [i for i in range(len(obstacles)) if i not in found]
     if moving:
         # The movers' vectors as arrays, their dot products all at once, the rest per mover.
