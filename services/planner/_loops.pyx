@@ -158,6 +158,35 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
             out[i] = outside
 
 
+def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
+                 const double[::1] hit_since, double known, double confirmed,
+                 unsigned char[::1] out):
+    """Into ``out`` (flat grids alike) whether each cell is occupied, seen at ``known``
+    or later and occupied since ``confirmed`` or earlier: ``Costmap.lethal``'s three
+    tests, in one pass over the grids."""
+    cdef Py_ssize_t i
+    for i in range(out.shape[0]):
+        out[i] = occupied[i] and seen[i] >= known and hit_since[i] <= confirmed
+
+
+def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, double oy,
+                 double resolution, const unsigned char[::1] grid, Py_ssize_t ny,
+                 unsigned char[::1] out):
+    """For each row of points (``xs[i, k]``, ``ys[i, k]``), whether any falls in a
+    flagged cell of the flat grid (``ny`` cells a column; beyond it: no), each found as
+    ``look_up`` finds it."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, k, ix, iy
+    for i in range(xs.shape[0]):
+        out[i] = 0
+        for k in range(xs.shape[1]):
+            ix = cell_index(xs[i, k] - ox, resolution)
+            iy = cell_index(ys[i, k] - oy, resolution)
+            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny) and grid[ix * ny + iy]:
+                out[i] = 1
+                break
+
+
 def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
                 const long[::1] di, const long[::1] dj, unsigned char[::1] out):
     """Flag in ``out`` (the flat grid, ``ny`` cells a column) every cell within the
@@ -256,6 +285,28 @@ def project_on(const double[:, ::1] points, const double[::1] lengths, double px
         if k == 0 or d < best_d or (d != d and best_d == best_d):  # the first nan wins
             best, best_d, best_t, best_l2 = k, d, t, l2
     return lengths[best] + best_t * sqrt(best_l2), best_d
+
+
+def point_on(const double[:, ::1] points, const double[::1] lengths, double s):
+    """(x, y) of ``global_path.point_at``: the point of the polyline ``points`` (n >= 2,
+    cumulative ``lengths``) at arc length ``s``, clamped to [0, length] as Python's
+    ``min`` and ``max`` do; the segment the one ``np.searchsorted(lengths, s, "right")``
+    finds (the last for a nan), its fraction 0 on a segment shorter than 1e-12."""
+    cdef Py_ssize_t n = points.shape[0], k = 0
+    cdef double seg, t
+    if n < 2:
+        raise ValueError("a path needs two points to find a point on")
+    s = 0.0 if 0.0 > s else s
+    s = lengths[n - 1] if lengths[n - 1] < s else s
+    if s != s:
+        k = n
+    while k < n and lengths[k] <= s:
+        k += 1
+    k = min(k - 1, n - 2)
+    seg = lengths[k + 1] - lengths[k]
+    t = 0.0 if seg < 1e-12 else (s - lengths[k]) / seg
+    return (points[k, 0] + t * (points[k + 1, 0] - points[k, 0]),
+            points[k, 1] + t * (points[k + 1, 1] - points[k, 1]))
 
 
 def box_gaps(double sx, double sy, double dx, double dy, double length, Py_ssize_t count,

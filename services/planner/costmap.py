@@ -45,8 +45,10 @@ from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
+    lethal_cells,
     line_any,
     look_up,
+    look_up_rows,
     return_bounds,
     stamp_discs,
     trace_scan,
@@ -131,6 +133,8 @@ class Costmap:
         self._gap: npt.NDArray[np.float64] | None = None  # of _inflated's lethal cells
         self._disc = _disc_offsets(resolution, inflation)
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
+        # cut_off's labelled free space, with the wall memory and clearance it is of.
+        self._regions: tuple[BoolGrid, float, npt.NDArray[np.int32]] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -268,8 +272,7 @@ class Costmap:
             return False  # beyond the grid: no knowledge, no verdict
         if not self.walls.any():
             return False
-        free = self._distances(self.walls) > clearance
-        labels, _ = label(free)
+        labels = self._free_regions(clearance)
         reach = math.ceil(clearance / self.resolution) + 1
 
         def near(cell: npt.NDArray[np.int64]) -> set[int]:
@@ -278,6 +281,17 @@ class Costmap:
             return set(np.unique(window[window > 0]).tolist())
 
         return not near(ends[0]) & near(ends[1])
+
+    def _free_regions(self, clearance: float) -> npt.NDArray[np.int32]:
+        """The connected regions of the cells farther than ``clearance`` from the wall
+        memory (scipy's ``label``, 0 elsewhere); kept while the wall memory stays the
+        same, which it mostly does between one look and the next."""
+        if (self._regions is not None and self._regions[1] == clearance
+                and np.array_equal(self._regions[0], self.walls)):
+            return self._regions[2]
+        labels = np.asarray(label(self._distances(self.walls) > clearance)[0], dtype=np.int32)
+        self._regions = (self.walls.copy(), clearance, labels)
+        return labels
 
     def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
@@ -289,9 +303,12 @@ class Costmap:
 
     def lethal(self) -> BoolGrid:
         """Cells occupied when last seen, within the decay time, and for at least the
-        confirmation time."""
-        return np.asarray(self.occupied & self.known()
-                          & (self.hit_since <= self.now - self.confirm))
+        confirmation time (in one compiled pass, ``_loops.lethal_cells``)."""
+        out = np.empty(self.shape, dtype=bool)
+        lethal_cells(_flat(self.occupied).view(np.uint8), _flat(self.seen),
+                     _flat(self.hit_since), self.now - self.decay, self.now - self.confirm,
+                     _flat(out).view(np.uint8))
+        return out
 
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
         # Lethal cells change only with the grids and the time (decay, confirmation):
@@ -342,6 +359,17 @@ class Costmap:
         ``outside`` (free by default: the local checks near the robot, which the grid
         always holds with room to spare; the global path passes True)."""
         return self._look_up(points, self.blocked(), outside)
+
+    def blocked_rows(self, xs: Vec, ys: Vec) -> npt.NDArray[np.bool_]:
+        """For each row of points (``xs[i]``, ``ys[i]``), whether any lies in a blocked
+        cell (beyond the grid: free, as for ``blocked_at``), in compiled code
+        (``_loops.look_up_rows``), stopping at the first."""
+        out = np.empty(xs.shape[0], dtype=bool)
+        look_up_rows(np.ascontiguousarray(xs, dtype=np.float64),
+                     np.ascontiguousarray(ys, dtype=np.float64), float(self.origin[0]),
+                     float(self.origin[1]), self.resolution,
+                     _flat(self.blocked()).view(np.uint8), self.shape[1], out.view(np.uint8))
+        return out
 
     def blocked_along(self, start: tuple[float, float], direction: tuple[float, float],
                       length: float, count: int) -> bool:

@@ -155,6 +155,12 @@ class Planner:
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0
         self.safety_heading: float | None = None  # the safety stage's last heading
+        self.safety_settings = safety.Settings(
+            horizon=params.safety_horizon, step=params.safety_step,
+            margin=params.safety_margin, growth=params.safety_growth,
+            comfort=params.safety_comfort, tau=params.safety_tau,
+            fan_step=math.radians(params.safety_fan_deg), speeds=params.safety_speeds,
+            turn_cost=params.safety_turn_cost)
         self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
         # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).
         self.last_seen_movers: dict[int, tuple[Obstacle, float]] = {}
@@ -346,16 +352,17 @@ class Planner:
         ob = a.obstacle
         step = self.p.map_resolution
         reach = ob.radius + step
-        ring = np.array([[ob.position[0] + dx, ob.position[1] + dy]
-                         for dx in np.arange(-reach, reach + 1e-9, step)
-                         for dy in np.arange(-reach, reach + 1e-9, step)
-                         if dx * dx + dy * dy <= reach * reach])
+        offsets = np.arange(-reach, reach + 1e-9, step)
+        dx, dy = np.meshgrid(offsets, offsets, indexing="ij")
+        disc = dx * dx + dy * dy <= reach * reach
+        ring = np.column_stack([ob.position[0] + dx[disc], ob.position[1] + dy[disc]])
         lo, hi = cell_squares(ob.cells, self.p.cell)
         # Edges included: a box may hold only a sliver of the face, along its edge.
         xs = np.linspace(lo[0], hi[0], math.ceil((hi[0] - lo[0]) / step) + 1)
         ys = np.linspace(lo[1], hi[1], math.ceil((hi[1] - lo[1]) / step) + 1)
-        box = np.array([[x, y] for x in xs for y in ys], dtype=np.float64).reshape(-1, 2)
-        return bool(self.costmap.lethal_at(np.vstack([ring.reshape(-1, 2), box])).any())
+        bx, by = np.meshgrid(xs, ys, indexing="ij")
+        box = np.column_stack([bx.ravel(), by.ravel()])
+        return bool(self.costmap.lethal_at(np.vstack([ring, box])).any())
 
     def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
         """Beyond the paper: whether the straight way to ``target`` is free on the map's
@@ -500,16 +507,11 @@ class Planner:
             np.array([o.radius for o in movers], dtype=np.float64),
             np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64),
             None if ages is None else np.asarray(ages, dtype=np.float64))
-        settings = safety.Settings(
-            horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
-            growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
-            fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
-            turn_cost=p.safety_turn_cost)
         heading = math.atan2(target[1] - pose[1], target[0] - pose[0])
         carrot = self._carrot(np.array(pose[:2], dtype=np.float64), path_target)
-        blocked = self.costmap.blocked_at if self.costmap is not None else None
+        blocked = self.costmap.blocked_rows if self.costmap is not None else None
         return safety.choose(robot, (heading, speed), group, carrot, blocked,
-                             self.safety_heading, settings)
+                             self.safety_heading, self.safety_settings)
 
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far

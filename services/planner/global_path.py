@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from zenav.services.planner._loops import project_on
+from zenav.services.planner._loops import point_on, project_on
 from zenav.services.planner.costmap import Costmap
 from zenav.services.planner.field import grid_distances
 
@@ -209,15 +209,11 @@ def project(points: Vec, p: Vec, lengths: Vec | None = None) -> tuple[float, flo
 
 def point_at(points: Vec, s: float, lengths: Vec | None = None) -> Vec:
     """The point of the path at arc length ``s`` (clamped to its ends); ``lengths`` as
-    for :func:`project`."""
+    for :func:`project`; in compiled code (``_loops.point_on``)."""
     if lengths is None:
         lengths = arc_lengths(points)
-    s = min(max(s, 0.0), float(lengths[-1]))
-    k = int(np.searchsorted(lengths, s, side="right") - 1)
-    k = min(k, len(points) - 2)
-    seg = float(lengths[k + 1] - lengths[k])
-    t = 0.0 if seg < 1e-12 else (s - float(lengths[k])) / seg
-    return np.asarray(points[k] + t * (points[k + 1] - points[k]), dtype=np.float64)
+    return np.array(point_on(np.ascontiguousarray(points, dtype=np.float64), lengths,
+                             float(s)), dtype=np.float64)
 
 
 def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float,

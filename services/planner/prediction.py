@@ -153,12 +153,10 @@ def line_crossing(d: Point, rel: Point, u: Point) -> tuple[float, float] | None:
 
 
 def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
-                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment | None:
-    """(b) for a standing obstacle, from the gaps (m, clearance taken off) between its grid
-    area and each of the ``count`` points along the path: ``first``, the index of the
-    first negative one (-1: none, then None), and ``least``, the smallest."""
-    if first < 0:
-        return None
+                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment:
+    """(b) for a standing obstacle on the path, from the gaps (m, clearance taken off)
+    between its grid area and each of the ``count`` points along the path: ``first``,
+    the index of the first negative one, and ``least``, the smallest."""
     along = float((np.asarray(obstacle.position, dtype=np.float64) - robot) @ direction)
     s_hit = first * path_length / (count - 1)
     centre_s = min(max(along, 0.0), path_length)
@@ -167,10 +165,6 @@ def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
     return Assessment(obstacle, "b", True, (rx + dx * centre_s, ry + dy * centre_s), s_hit,
                       s_hit / speed if speed > 0 else math.inf, math.inf, least, along, 0.0,
                       (dx, dy))
-
-
-def _moving(obstacle: Obstacle, moving_speed: float) -> bool:
-    return obstacle.kind == "dynamic" and c_hypot(*obstacle.velocity) >= moving_speed
 
 
 def _row_dots(a: Vec, b: Vec) -> list[float]:
@@ -250,8 +244,10 @@ def assess_all(
     (``_loops.box_gaps``). The movers' vectors are
     arrays of all of them, their dot products taken in one call each; the rest is
     arithmetic on plain numbers, mover by mover."""
-    standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
-    found: dict[int, Assessment | None] = {}
+    speeds = [c_hypot(*ob.velocity) for ob in obstacles]
+    standing = [i for i, ob in enumerate(obstacles)
+                if ob.kind != "dynamic" or speeds[i] < moving_speed]
+    found: list[Assessment | None] = [None] * len(obstacles)
     if standing:
         count = path_count(path_length, cell / 4)
         first = np.empty(len(standing), dtype=np.int64)
@@ -262,9 +258,10 @@ def assess_all(
                  np.array([robot_radius + margins[i] for i in standing], dtype=np.float64),
                  first, least)
         for i, hit, smallest in zip(standing, first.tolist(), least.tolist(), strict=True):
-            found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i], hit,
-                                    smallest, count)
-    moving = [i for i in range(len(obstacles)) if i not in found]
+            if hit >= 0:
+                found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i],
+                                        hit, smallest, count)
+    moving = sorted(set(range(len(obstacles))).difference(standing))
     if moving:
         # The movers' vectors as arrays, their dot products all at once, the rest per mover.
         rel = np.array([obstacles[i].position for i in moving], dtype=np.float64) - robot
@@ -280,11 +277,11 @@ def assess_all(
             t_path = min(horizons[i], path_length / speed) if speed > 0 else horizons[i]
             found[i] = _mover(
                 robot_xy, heading, speed, path_length, ob, (rx, ry), along[k], along_speed[k],
-                c_hypot(*ob.velocity),
+                speeds[i],
                 closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
                 robot_radius + ob.radius + margins[i], head_on_cos=head_on_cos,
                 same_way_cos=same_way_cos, meet_rule=meet_rule, following=following[i])
-    return [a for i in range(len(obstacles)) if (a := found[i]) is not None]
+    return [a for a in found if a is not None]
 
 
 def assess(

@@ -192,10 +192,36 @@ def test_project_is_the_numpy_projection_to_the_bit(seed: int) -> None:
         want = numpy_project(points, p)
         assert project(points, p) == want
         assert project(points, p, arc_lengths(points)) == want
-        s = float(rng.uniform(-1.0, want[0] + 1.0))
-        assert point_at(points, s, arc_lengths(points)).tobytes() == point_at(points, s).tobytes()
 
 
 def test_project_needs_a_path_of_two_points() -> None:
     with pytest.raises(ValueError):
         project(np.array([[0.0, 0.0]]), np.array([1.0, 1.0]))
+
+
+def numpy_point_at(points: np.ndarray, s: float) -> np.ndarray:
+    """The point at an arc length as numpy operations (the code ``point_on`` replaced)."""
+    lengths = arc_lengths(points)
+    s = min(max(s, 0.0), float(lengths[-1]))
+    k = int(np.searchsorted(lengths, s, side="right") - 1)
+    k = min(k, len(points) - 2)
+    seg = float(lengths[k + 1] - lengths[k])
+    t = 0.0 if seg < 1e-12 else (s - float(lengths[k])) / seg
+    return np.asarray(points[k] + t * (points[k + 1] - points[k]), dtype=np.float64)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_point_at_is_the_numpy_point_to_the_bit(seed: int) -> None:
+    """``point_at`` (compiled) against the numpy code it replaced: random polylines with
+    repeated vertices now and then, arc lengths before the start, at every vertex, in
+    between and past the end."""
+    rng = np.random.default_rng(seed)
+    for _ in range(100):
+        points = rng.uniform(-5.0, 5.0, (int(rng.integers(2, 9)), 2))
+        if rng.random() < 0.3:
+            points[int(rng.integers(1, len(points)))] = points[0]
+        lengths = arc_lengths(points)
+        for s in [*lengths.tolist(), *rng.uniform(-1.0, float(lengths[-1]) + 1.0, 5)]:
+            want = numpy_point_at(points, s).tobytes()
+            assert point_at(points, s).tobytes() == want
+            assert point_at(points, s, lengths).tobytes() == want
