@@ -158,17 +158,6 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
             out[i] = outside
 
 
-def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
-                 const double[::1] hit_since, double known, double confirmed,
-                 unsigned char[::1] out):
-    """Into ``out`` (flat grids alike) whether each cell is occupied, seen at ``known``
-    or later and occupied since ``confirmed`` or earlier: ``Costmap.lethal``'s three
-    tests, in one pass over the grids."""
-    cdef Py_ssize_t i
-    for i in range(out.shape[0]):
-        out[i] = occupied[i] and seen[i] >= known and hit_since[i] <= confirmed
-
-
 def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, double oy,
                  double resolution, const unsigned char[::1] grid, Py_ssize_t ny,
                  unsigned char[::1] out):

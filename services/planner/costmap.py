@@ -45,7 +45,6 @@ from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
-    lethal_cells,
     line_any,
     look_up,
     look_up_rows,
@@ -303,12 +302,9 @@ class Costmap:
 
     def lethal(self) -> BoolGrid:
         """Cells occupied when last seen, within the decay time, and for at least the
-        confirmation time (in one compiled pass, ``_loops.lethal_cells``)."""
-        out = np.empty(self.shape, dtype=bool)
-        lethal_cells(_flat(self.occupied).view(np.uint8), _flat(self.seen),
-                     _flat(self.hit_since), self.now - self.decay, self.now - self.confirm,
-                     _flat(out).view(np.uint8))
-        return out
+        confirmation time."""
+        return np.asarray(self.occupied & self.known()
+                          & (self.hit_since <= self.now - self.confirm))
 
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
         # Lethal cells change only with the grids and the time (decay, confirmation):

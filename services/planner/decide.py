@@ -35,6 +35,7 @@ import numpy.typing as npt
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
 from zenav.services.geometry import wrap_angle
 from zenav.services.planner import safety
+from zenav.services.planner._loops import box_gaps
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import command_toward
@@ -53,7 +54,6 @@ from zenav.services.planner.prediction import (
     Obstacle,
     assess_all,
     cell_squares,
-    gap_to_boxes,
     path_count,
     path_points,
 )
@@ -239,7 +239,17 @@ class Planner:
         if length < 1e-9:
             return None
         s0 = project(self.path, point, self.lengths)[0]
-        lows, highs = self._boxes(statics)
+        # The gaps from points along each leg to the statics' grid areas, measured as
+        # ``gap_to_boxes`` does, in the compiled loop of the (b) test (``box_gaps``, no
+        # clearance taken off): each leg is clear when no point of it is nearer any
+        # area than ``need`` or than ``point`` itself is (``here``).
+        cells = np.array([o.cells for o in statics], dtype=np.int64).reshape(-1, 4)
+        zero = np.zeros(len(cells))
+        first = np.empty(len(cells), dtype=np.int64)
+        least = np.empty(len(cells), dtype=np.float64)
+        px, py = point.tolist()
+        box_gaps(px, py, 1.0, 0.0, 0.0, 2, cells, p.cell, zero, first, least)
+        here = min(least.tolist(), default=math.inf)
         need = p.robot_radius + p.safety_margin
         for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
             on_path = point_at(self.path, max(float(s), 0.0), self.lengths)
@@ -249,9 +259,10 @@ class Planner:
                 continue
             if leg_length < 1e-9:
                 return on_path
-            samples = path_points(point, leg / leg_length, leg_length, p.cell / 4)
-            gaps = gap_to_boxes(samples, lows, highs)
-            if (gaps >= min(need, float(gaps[0]))).all():
+            dx, dy = (leg / leg_length).tolist()
+            box_gaps(px, py, dx, dy, leg_length, path_count(leg_length, p.cell / 4), cells,
+                     p.cell, zero, first, least)
+            if min(least.tolist(), default=math.inf) >= min(need, here):
                 return on_path
         return None
 

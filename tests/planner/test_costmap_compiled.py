@@ -239,24 +239,6 @@ def test_blocked_along_looks_up_the_points_of_path_points(seed: int) -> None:
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_lethal_is_the_three_numpy_tests_in_one_pass(seed: int) -> None:
-    """``lethal`` (compiled ``lethal_cells``) is the numpy expression it replaced: occupied,
-    seen within the decay time, occupied for the confirmation time; on a map of several
-    scans with cells of every kind (young marks, old ones, decayed ones)."""
-    rng = np.random.default_rng(seed)
-    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=2.0, inflation=0.3,
-                 confirm=0.5, padding=1.0, max_size=30.0)
-    for stamp in np.arange(0.0, 3.0, 0.25):
-        pose = (float(rng.uniform(0.0, 2.0)), float(rng.uniform(0.0, 2.0)), 0.3)
-        cm.update(ScanData(pose, rng.uniform(0.5, 4.0, 181), -math.pi / 2, math.pi / 180,
-                           8.0), float(stamp))
-        want = cm.occupied & (cm.seen >= cm.now - cm.decay) & (
-            cm.hit_since <= cm.now - cm.confirm)
-        assert np.array_equal(cm.lethal(), want)
-    assert want.any() and (cm.occupied & ~want).any()
-
-
-@pytest.mark.parametrize("seed", range(5))
 def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
     """``blocked_rows`` (compiled ``look_up_rows``) is ``blocked_at`` of every point, any
     per row: rows of points inside and beyond the grid."""
