@@ -132,8 +132,6 @@ class Costmap:
         self._gap: npt.NDArray[np.float64] | None = None  # of _inflated's lethal cells
         self._disc = _disc_offsets(resolution, inflation)
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
-        # cut_off's labelled free space, with the wall memory and clearance it is of.
-        self._regions: tuple[BoolGrid, float, npt.NDArray[np.int32]] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -271,7 +269,8 @@ class Costmap:
             return False  # beyond the grid: no knowledge, no verdict
         if not self.walls.any():
             return False
-        labels = self._free_regions(clearance)
+        free = self._distances(self.walls) > clearance
+        labels, _ = label(free)
         reach = math.ceil(clearance / self.resolution) + 1
 
         def near(cell: npt.NDArray[np.int64]) -> set[int]:
@@ -280,17 +279,6 @@ class Costmap:
             return set(np.unique(window[window > 0]).tolist())
 
         return not near(ends[0]) & near(ends[1])
-
-    def _free_regions(self, clearance: float) -> npt.NDArray[np.int32]:
-        """The connected regions of the cells farther than ``clearance`` from the wall
-        memory (scipy's ``label``, 0 elsewhere); kept while the wall memory stays the
-        same, which it mostly does between one look and the next."""
-        if (self._regions is not None and self._regions[1] == clearance
-                and np.array_equal(self._regions[0], self.walls)):
-            return self._regions[2]
-        labels = np.asarray(label(self._distances(self.walls) > clearance)[0], dtype=np.int32)
-        self._regions = (self.walls.copy(), clearance, labels)
-        return labels
 
     def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
