@@ -5,12 +5,15 @@ numpy ran these as one pass over whole arrays per step, which costs more in call
 overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
 over the map, about 41,000 samples a scan in the perf world, and the marking), the
 unicycle roll-out of every safety candidate over the horizon, and the collision
-prediction's gaps between the path and each standing obstacle's grid area. Here they
-are plain loops with the same floating-point operations, in the same order, as the
-numpy code they replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors
-of the cell indices as numpy has them), so the results are the same to the bit. The
-Python callers (``costmap.py``, ``safety.py``, ``prediction.py``) own the meaning;
-``_loops.pyi`` gives their types.
+prediction's gaps between the path and each standing obstacle's grid area; and the
+small ones numpy ran as a dozen calls on a few numbers each, several times a scan: the
+projection on the global path and the point at an arc length, the map's look-ups along
+a straight line and along each roll-out. Here they are plain loops with the same
+floating-point operations, in the same order, as the numpy code they replaced (angles
+wrapped by ``_angles.pxi``, ``hypot``, ``np.linspace``'s points and the floors of the
+cell indices as numpy has them), so the results are the same to the bit. The Python
+callers (``costmap.py``, ``safety.py``, ``prediction.py``, ``global_path.py``) own the
+meaning; ``_loops.pyi`` gives their types.
 """
 
 import numpy as np
