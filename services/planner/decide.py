@@ -248,7 +248,7 @@ class Planner:
         first = np.empty(len(cells), dtype=np.int64)
         least = np.empty(len(cells), dtype=np.float64)
         px, py = point.tolist()
-        box_gaps(px, py, 1.0, 0.0, 0.0, 2, cells, p.cell, zero, first, least)
+        box_gaps(px, py, 1.0, 0.0, 0.0, 2, cells, p.cell, zero, first, least)  # point alone
         here = min(least.tolist(), default=math.inf)
         need = p.robot_radius + p.safety_margin
         for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
