@@ -5,12 +5,15 @@ numpy ran these as one pass over whole arrays per step, which costs more in call
 overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
 over the map, about 41,000 samples a scan in the perf world, and the marking), the
 unicycle roll-out of every safety candidate over the horizon, and the collision
-prediction's gaps between the path and each standing obstacle's grid area. Here they
-are plain loops with the same floating-point operations, in the same order, as the
-numpy code they replaced (angles wrapped by ``_angles.pxi``, ``hypot`` and the floors
-of the cell indices as numpy has them), so the results are the same to the bit. The
-Python callers (``costmap.py``, ``safety.py``, ``prediction.py``) own the meaning;
-``_loops.pyi`` gives their types.
+prediction's gaps between the path and each standing obstacle's grid area; and the
+small ones numpy ran as a dozen calls on a few numbers each, several times a scan: the
+projection on the global path and the point at an arc length, the map's look-ups along
+a straight line and along each roll-out. Here they are plain loops with the same
+floating-point operations, in the same order, as the numpy code they replaced (angles
+wrapped by ``_angles.pxi``, ``hypot``, ``np.linspace``'s points and the floors of the
+cell indices as numpy has them), so the results are the same to the bit. The Python
+callers (``costmap.py``, ``safety.py``, ``prediction.py``, ``global_path.py``) own the
+meaning; ``_loops.pyi`` gives their types.
 """
 
 import numpy as np
@@ -158,6 +161,24 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
             out[i] = outside
 
 
+def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, double oy,
+                 double resolution, const unsigned char[::1] grid, Py_ssize_t ny,
+                 unsigned char[::1] out):
+    """For each row of points (``xs[i, k]``, ``ys[i, k]``), whether any falls in a
+    flagged cell of the flat grid (``ny`` cells a column; beyond it: no), each found as
+    ``look_up`` finds it."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, k, ix, iy
+    for i in range(xs.shape[0]):
+        out[i] = 0
+        for k in range(xs.shape[1]):
+            ix = cell_index(xs[i, k] - ox, resolution)
+            iy = cell_index(ys[i, k] - oy, resolution)
+            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny) and grid[ix * ny + iy]:
+                out[i] = 1
+                break
+
+
 def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
                 const long[::1] di, const long[::1] dj, unsigned char[::1] out):
     """Flag in ``out`` (the flat grid, ``ny`` cells a column) every cell within the
@@ -196,15 +217,109 @@ def drive(const double[::1] headings, const double[::1] speeds, double dt, doubl
             ys[i, k] = y
 
 
-def box_gaps(const double[:, ::1] points, const long[:, ::1] cells, double cell,
-             const double[::1] clearances, long[::1] first, double[::1] least):
+cdef inline double spaced(Py_ssize_t i, Py_ssize_t count, double length,
+                          double step) noexcept nogil:
+    """``np.linspace(0, length, count)[i]`` to the bit (``count`` >= 2, ``step`` =
+    ``length / (count - 1)``): ``i * step`` (or ``i / (count - 1) * length`` when the step
+    is 0), plus the start 0, and the last point ``length`` itself."""
+    if i == count - 1:
+        return length
+    if step == 0.0:
+        return (<double>i / <double>(count - 1)) * length + 0.0
+    return <double>i * step + 0.0
+
+
+def line_any(double sx, double sy, double dx, double dy, double length, Py_ssize_t count,
+             double ox, double oy, double resolution, const unsigned char[::1] grid,
+             Py_ssize_t ny, unsigned char outside):
+    """Whether any of the ``count`` points of ``prediction.path_points`` from (sx, sy)
+    along (dx, dy) for ``length`` m falls in a flagged cell of the flat grid (``ny``
+    cells a column; ``outside`` beyond it), as ``look_up`` finds each point's flag."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, ix, iy
+    cdef double step = length / <double>(count - 1), s
+    cdef unsigned char flag
+    for i in range(count):
+        s = spaced(i, count, length, step)
+        ix = cell_index(sx + s * dx - ox, resolution)
+        iy = cell_index(sy + s * dy - oy, resolution)
+        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+            flag = grid[ix * ny + iy]
+        else:
+            flag = outside
+        if flag:
+            return True
+    return False
+
+
+def project_on(const double[:, ::1] points, const double[::1] lengths, double px,
+               double py):
+    """(s, d) of ``global_path.project``: the arc length of the point of the polyline
+    ``points`` (n >= 2, cumulative ``lengths`` at its vertices) nearest (px, py), and
+    the distance to it; each segment's numbers as numpy had them (the squared length
+    at least 1e-18, the fraction clipped to [0, 1] as ``np.clip`` does, ``hypot``), the
+    first nearest segment winning, as ``np.argmin`` has it. (The arc lengths are the
+    caller's: they change only with the path.)"""
+    cdef Py_ssize_t k, best = 0
+    cdef double ax, ay, abx, aby, l2, t, d, best_d = INFINITY, best_t = 0.0, best_l2 = 1.0
+    if points.shape[0] < 2:
+        raise ValueError("a path needs two points to project on")
+    for k in range(points.shape[0] - 1):
+        ax, ay = points[k, 0], points[k, 1]
+        abx = points[k + 1, 0] - ax
+        aby = points[k + 1, 1] - ay
+        l2 = abx * abx + aby * aby
+        l2 = 1e-18 if l2 < 1e-18 else l2  # (a nan stays nan, as in numpy)
+        t = ((px - ax) * abx + (py - ay) * aby) / l2
+        t = 0.0 if t <= 0.0 else t
+        t = 1.0 if t >= 1.0 else t
+        d = hypot(ax + t * abx - px, ay + t * aby - py)
+        if k == 0 or d < best_d or (d != d and best_d == best_d):  # the first nan wins
+            best, best_d, best_t, best_l2 = k, d, t, l2
+    return lengths[best] + best_t * sqrt(best_l2), best_d
+
+
+def point_on(const double[:, ::1] points, const double[::1] lengths, double s):
+    """(x, y) of ``global_path.point_at``: the point of the polyline ``points`` (n >= 2,
+    cumulative ``lengths``) at arc length ``s``, clamped to [0, length] as Python's
+    ``min`` and ``max`` do; the segment the one ``np.searchsorted(lengths, s, "right")``
+    finds (the last for a nan), its fraction 0 on a segment shorter than 1e-12."""
+    cdef Py_ssize_t n = points.shape[0], k = 0
+    cdef double seg, t
+    if n < 2:
+        raise ValueError("a path needs two points to find a point on")
+    s = 0.0 if 0.0 > s else s
+    s = lengths[n - 1] if lengths[n - 1] < s else s
+    if s != s:
+        k = n
+    while k < n and lengths[k] <= s:
+        k += 1
+    k = min(k - 1, n - 2)
+    seg = lengths[k + 1] - lengths[k]
+    t = 0.0 if seg < 1e-12 else (s - lengths[k]) / seg
+    return (points[k, 0] + t * (points[k + 1, 0] - points[k, 0]),
+            points[k, 1] + t * (points[k + 1, 1] - points[k, 1]))
+
+
+def box_gaps(double sx, double sy, double dx, double dy, double length, Py_ssize_t count,
+             const long[:, ::1] cells, double cell, const double[::1] clearances,
+             long[::1] first, double[::1] least):
     """For each grid box j (row ix_min, ix_max, iy_min, iy_max of ``cells``; cell i
-    spans [(i - 1/2) cell, (i + 1/2) cell]) the gap of every point (n, 2) to it, as
-    ``prediction.assess`` measures it: ``hypot`` of how far the point is outside the box
-    along each axis, less ``clearances[j]``. Into ``first[j]`` the index of the first
+    spans [(i - 1/2) cell, (i + 1/2) cell]) the gap to it of every one of the ``count``
+    points of ``prediction.path_points`` from (sx, sy) along (dx, dy) for ``length`` m,
+    as ``prediction.assess`` measures it: ``hypot`` of how far the point is outside the
+    box along each axis, less ``clearances[j]``. Into ``first[j]`` the index of the first
     point with a negative gap (-1: none), into ``least[j]`` the smallest gap."""
-    cdef double lo_x, lo_y, hi_x, hi_y, out_x, out_y, gap, smallest
+    cdef double lo_x, lo_y, hi_x, hi_y, out_x, out_y, gap, smallest, s
+    cdef double step = length / <double>(count - 1)
     cdef Py_ssize_t i, j, hit
+    xs_array = np.empty(count, dtype=np.float64)
+    ys_array = np.empty(count, dtype=np.float64)
+    cdef double[::1] xs = xs_array, ys = ys_array
+    for i in range(count):
+        s = spaced(i, count, length, step)
+        xs[i] = sx + s * dx
+        ys[i] = sy + s * dy
     for j in range(cells.shape[0]):
         lo_x = (<double>cells[j, 0] - 0.5) * cell
         hi_x = (<double>cells[j, 1] + 0.5) * cell
@@ -212,9 +327,9 @@ def box_gaps(const double[:, ::1] points, const long[:, ::1] cells, double cell,
         hi_y = (<double>cells[j, 3] + 0.5) * cell
         hit = -1
         smallest = INFINITY
-        for i in range(points.shape[0]):
-            out_x = max(max(lo_x - points[i, 0], points[i, 0] - hi_x), 0.0)
-            out_y = max(max(lo_y - points[i, 1], points[i, 1] - hi_y), 0.0)
+        for i in range(count):
+            out_x = max(max(lo_x - xs[i], xs[i] - hi_x), 0.0)
+            out_y = max(max(lo_y - ys[i], ys[i] - hi_y), 0.0)
             gap = hypot(out_x, out_y) - clearances[j]
             if gap < 0.0 and hit < 0:
                 hit = i

@@ -45,7 +45,9 @@ from scipy.ndimage import distance_transform_edt, label
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
+    line_any,
     look_up,
+    look_up_rows,
     return_bounds,
     stamp_discs,
     trace_scan,
@@ -341,6 +343,29 @@ class Costmap:
         ``outside`` (free by default: the local checks near the robot, which the grid
         always holds with room to spare; the global path passes True)."""
         return self._look_up(points, self.blocked(), outside)
+
+    def blocked_rows(self, xs: Vec, ys: Vec) -> npt.NDArray[np.bool_]:
+        """For each row of points (``xs[i]``, ``ys[i]``), whether any lies in a blocked
+        cell (beyond the grid: free, as for ``blocked_at``), in compiled code
+        (``_loops.look_up_rows``), stopping at the first."""
+        out = np.empty(xs.shape[0], dtype=bool)
+        look_up_rows(np.ascontiguousarray(xs, dtype=np.float64),
+                     np.ascontiguousarray(ys, dtype=np.float64), float(self.origin[0]),
+                     float(self.origin[1]), self.resolution,
+                     _flat(self.blocked()).view(np.uint8), self.shape[1], out.view(np.uint8))
+        return out
+
+    def blocked_along(self, start: tuple[float, float], direction: tuple[float, float],
+                      length: float, count: int) -> bool:
+        """Whether any of ``count`` points evenly spaced along the straight way from
+        ``start`` along ``direction`` (unit) for ``length`` m, both ends included (the
+        points of ``prediction.path_points``), lies in a blocked cell (beyond the grid:
+        free, as for ``blocked_at``); in compiled code (``_loops.line_any``), stopping at
+        the first."""
+        grid = self.blocked()
+        return line_any(start[0], start[1], direction[0], direction[1], length, count,
+                        float(self.origin[0]), float(self.origin[1]), self.resolution,
+                        _flat(grid).view(np.uint8), self.shape[1], False)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
         return self._look_up(points, self._refresh()[0], False)

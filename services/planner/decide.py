@@ -35,6 +35,7 @@ import numpy.typing as npt
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
 from zenav.services.geometry import wrap_angle
 from zenav.services.planner import safety
+from zenav.services.planner._loops import box_gaps
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import command_toward
@@ -53,7 +54,7 @@ from zenav.services.planner.prediction import (
     Obstacle,
     assess_all,
     cell_squares,
-    gap_to_boxes,
+    path_count,
     path_points,
 )
 from zenav.services.planner.recovery import STEPS, Recovery, RecoverySettings
@@ -138,6 +139,7 @@ class Planner:
         self.costmap: Costmap | None = None
         self.plan: GlobalPlan | None = None
         self.path: Vec | None = None  # the global path's vertices, robot to goal
+        self.lengths: Vec | None = None  # the path's arc length at each vertex, m
         self.plan_count = 0  # bumped at every new path
         self.last_replan = -math.inf
         self.replan_asked: str | None = None  # why the next cycle must re-plan
@@ -153,6 +155,12 @@ class Planner:
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0
         self.safety_heading: float | None = None  # the safety stage's last heading
+        self.safety_settings = safety.Settings(
+            horizon=params.safety_horizon, step=params.safety_step,
+            margin=params.safety_margin, growth=params.safety_growth,
+            comfort=params.safety_comfort, tau=params.safety_tau,
+            fan_step=math.radians(params.safety_fan_deg), speeds=params.safety_speeds,
+            turn_cost=params.safety_turn_cost)
         self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
         # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).
         self.last_seen_movers: dict[int, tuple[Obstacle, float]] = {}
@@ -164,6 +172,7 @@ class Planner:
 
     def _set_path(self, points: Vec, reason: str) -> None:
         self.path = np.asarray(points, dtype=np.float64)
+        self.lengths = arc_lengths(self.path)  # kept: they change only with the path
         self.plan_count += 1
         cells: set[tuple[int, int]] = set()
         for a, b in zip(self.path[:-1], self.path[1:], strict=True):
@@ -176,25 +185,25 @@ class Planner:
         the farthest point of the path within the window that it can drive to in a
         straight line clear of them (beyond the paper: it rejoins the path past the
         obstacles it went round instead of cutting back into them)."""
-        assert self.path is not None
+        assert self.path is not None and self.lengths is not None
         p = self.p
-        length = float(arc_lengths(self.path)[-1])
+        lengths = self.lengths
+        length = float(lengths[-1])
         if length < 1e-9:
             return self.goal
-        s0, off_path = project(self.path, robot)
-        default = self.goal if s0 + p.lookahead >= length else point_at(self.path,
-                                                                          s0 + p.lookahead)
+        s0, off_path = project(self.path, robot, lengths)
+        default = self.goal if s0 + p.lookahead >= length else point_at(
+            self.path, s0 + p.lookahead, lengths)
         if len(self.path) > 2 and not self._chord_clear(robot, default):
             # The path bends within the look-ahead and the chord would cut the corner
             # into what the map holds: steer for the bend itself first.
-            lengths = arc_lengths(self.path)
             k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
             if k < len(self.path):
                 default = self.path[k]
         if not statics or off_path < p.cell / 2:
             return default
         rejoin = self._rejoin_point(robot, statics)
-        if rejoin is None or project(self.path, rejoin)[0] < s0 + p.lookahead:
+        if rejoin is None or project(self.path, rejoin, lengths)[0] < s0 + p.lookahead:
             return default
         return rejoin
 
@@ -224,25 +233,36 @@ class Planner:
     def _rejoin_point(self, point: Vec, statics: list[Obstacle]) -> Vec | None:
         """The farthest point of the global path within the window that ``point`` sees
         in a straight line clear of ``statics``; None if there is none."""
-        assert self.path is not None
+        assert self.path is not None and self.lengths is not None
         p = self.p
-        length = float(arc_lengths(self.path)[-1])
+        length = float(self.lengths[-1])
         if length < 1e-9:
             return None
-        s0 = project(self.path, point)[0]
-        lows, highs = self._boxes(statics)
+        s0 = project(self.path, point, self.lengths)[0]
+        # The gaps from points along each leg to the statics' grid areas, measured as
+        # ``gap_to_boxes`` does, in the compiled loop of the (b) test (``box_gaps``, no
+        # clearance taken off): each leg is clear when no point of it is nearer any
+        # area than ``need`` or than ``point`` itself is (``here``).
+        cells = np.array([o.cells for o in statics], dtype=np.int64).reshape(-1, 4)
+        zero = np.zeros(len(cells))
+        first = np.empty(len(cells), dtype=np.int64)
+        least = np.empty(len(cells), dtype=np.float64)
+        px, py = point.tolist()
+        box_gaps(px, py, 1.0, 0.0, 0.0, 2, cells, p.cell, zero, first, least)  # point alone
+        here = min(least.tolist(), default=math.inf)
         need = p.robot_radius + p.safety_margin
         for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
-            on_path = point_at(self.path, max(float(s), 0.0))
+            on_path = point_at(self.path, max(float(s), 0.0), self.lengths)
             leg = on_path - point
             leg_length = float(np.hypot(*leg))
             if leg_length > p.window_radius:
                 continue
             if leg_length < 1e-9:
                 return on_path
-            samples = path_points(point, leg / leg_length, leg_length, p.cell / 4)
-            gaps = gap_to_boxes(samples, lows, highs)
-            if (gaps >= min(need, float(gaps[0]))).all():
+            dx, dy = (leg / leg_length).tolist()
+            box_gaps(px, py, dx, dy, leg_length, path_count(leg_length, p.cell / 4), cells,
+                     p.cell, zero, first, least)
+            if min(least.tolist(), default=math.inf) >= min(need, here):
                 return on_path
         return None
 
@@ -288,11 +308,10 @@ class Planner:
         """How far the global path runs on from the robot in ``direction`` before it
         bends: the distance to the goal on the paper's straight path, to the next vertex
         on one that goes round what the map holds."""
-        if self.path is None or len(self.path) <= 2:
+        if self.path is None or self.lengths is None or len(self.path) <= 2:
             return float(np.hypot(*(self.goal - robot)))
-        s0 = project(self.path, robot)[0]
-        lengths = arc_lengths(self.path)
-        k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
+        s0 = project(self.path, robot, self.lengths)[0]
+        k = int(np.searchsorted(self.lengths, s0 + 1e-6, side="right"))
         end = 0.0
         for vertex in self.path[k:]:
             leg = vertex - robot
@@ -310,10 +329,18 @@ class Planner:
         distance = float(np.hypot(*offset))
         if distance <= self.p.map_resolution:
             return True
-        direction = offset / distance
-        samples = path_points(robot + direction * self.p.map_resolution, direction,
-                              distance - self.p.map_resolution, self.p.map_resolution / 2)
-        return not bool(self.costmap.blocked_at(samples).any())
+        return not self._blocked_along(robot, offset / distance, self.p.map_resolution,
+                                       distance)
+
+    def _blocked_along(self, robot: Vec, direction: Vec, first: float, length: float) -> bool:
+        """Whether the map blocks any of the points every half map cell from ``first`` to
+        ``length`` m along ``direction`` from ``robot`` (``Costmap.blocked_along``)."""
+        assert self.costmap is not None
+        rx, ry = robot.tolist()
+        dx, dy = direction.tolist()
+        return self.costmap.blocked_along(
+            (rx + dx * first, ry + dy * first), (dx, dy), length - first,
+            path_count(length - first, self.p.map_resolution / 2))
 
     def _threats(self, notes: list[Assessment], clear: bool, stamp: float
                  ) -> list[Assessment]:
@@ -336,16 +363,17 @@ class Planner:
         ob = a.obstacle
         step = self.p.map_resolution
         reach = ob.radius + step
-        ring = np.array([[ob.position[0] + dx, ob.position[1] + dy]
-                         for dx in np.arange(-reach, reach + 1e-9, step)
-                         for dy in np.arange(-reach, reach + 1e-9, step)
-                         if dx * dx + dy * dy <= reach * reach])
+        offsets = np.arange(-reach, reach + 1e-9, step)
+        dx, dy = np.meshgrid(offsets, offsets, indexing="ij")
+        disc = dx * dx + dy * dy <= reach * reach
+        ring = np.column_stack([ob.position[0] + dx[disc], ob.position[1] + dy[disc]])
         lo, hi = cell_squares(ob.cells, self.p.cell)
         # Edges included: a box may hold only a sliver of the face, along its edge.
         xs = np.linspace(lo[0], hi[0], math.ceil((hi[0] - lo[0]) / step) + 1)
         ys = np.linspace(lo[1], hi[1], math.ceil((hi[1] - lo[1]) / step) + 1)
-        box = np.array([[x, y] for x in xs for y in ys], dtype=np.float64).reshape(-1, 2)
-        return bool(self.costmap.lethal_at(np.vstack([ring.reshape(-1, 2), box])).any())
+        bx, by = np.meshgrid(xs, ys, indexing="ij")
+        box = np.column_stack([bx.ravel(), by.ravel()])
+        return bool(self.costmap.lethal_at(np.vstack([ring, box])).any())
 
     def _map_clear(self, robot: Vec, target: Vec, to_goal: bool) -> bool:
         """Beyond the paper: whether the straight way to ``target`` is free on the map's
@@ -364,10 +392,8 @@ class Planner:
         if to_goal:
             length = max(distance, min(self._straight_ahead(robot, direction),
                                        self.p.window_radius))
-        first = min(self.p.map_resolution, length)
-        samples = path_points(robot + direction * first, direction, length - first,
-                              self.p.map_resolution / 2)
-        if not self.costmap.blocked_at(samples).any():
+        if not self._blocked_along(robot, direction, min(self.p.map_resolution, length),
+                                   length):
             return True
         return to_goal and self._path_passable(robot, target)
 
@@ -381,12 +407,12 @@ class Planner:
         runs through inflated cells, a cell or two from the faces: that is no reason to
         leave the path for a detour on the 0.5 m boxes, which close such a gap."""
         assert self.costmap is not None
-        if self.path is None:
+        if self.path is None or self.lengths is None:
             return False
         p = self.p
         step = p.map_resolution / 2
-        s0 = project(self.path, robot)[0]
-        lengths = arc_lengths(self.path)
+        lengths = self.lengths
+        s0 = project(self.path, robot, lengths)[0]
         s = np.arange(s0, min(s0 + p.window_radius, float(lengths[-1])) + step / 2, step)
         along = np.column_stack([np.interp(s, lengths, self.path[:, 0]),
                                  np.interp(s, lengths, self.path[:, 1])])
@@ -492,27 +518,22 @@ class Planner:
             np.array([o.radius for o in movers], dtype=np.float64),
             np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64),
             None if ages is None else np.asarray(ages, dtype=np.float64))
-        settings = safety.Settings(
-            horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
-            growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
-            fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
-            turn_cost=p.safety_turn_cost)
         heading = math.atan2(target[1] - pose[1], target[0] - pose[0])
         carrot = self._carrot(np.array(pose[:2], dtype=np.float64), path_target)
-        blocked = self.costmap.blocked_at if self.costmap is not None else None
+        blocked = self.costmap.blocked_rows if self.costmap is not None else None
         return safety.choose(robot, (heading, speed), group, carrot, blocked,
-                             self.safety_heading, settings)
+                             self.safety_heading, self.safety_settings)
 
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far
         along as the top speed reaches within the horizon, past the look-ahead point."""
         p = self.p
-        if self.path is None:
+        if self.path is None or self.lengths is None:
             return path_target
-        length = float(arc_lengths(self.path)[-1])
-        s0 = project(self.path, robot)[0]
+        length = float(self.lengths[-1])
+        s0 = project(self.path, robot, self.lengths)[0]
         s = s0 + p.lookahead + p.max_speed * p.safety_horizon
-        return self.goal if s >= length else point_at(self.path, s)
+        return self.goal if s >= length else point_at(self.path, s, self.lengths)
 
     def _crossed(self, robot: Vec, target: Vec, ob: Obstacle) -> bool:
         """Whether a crosser has got across the line the robot is driving along (it is
@@ -912,10 +933,10 @@ class Planner:
 
     def to_go(self, robot: Vec) -> float:
         """Distance still to go along the global path (plus the way back onto it), m."""
-        if self.path is None:
+        if self.path is None or self.lengths is None:
             return float(np.hypot(*(self.goal - robot)))
-        s0, off = project(self.path, robot)
-        return float(arc_lengths(self.path)[-1]) - s0 + off
+        s0, off = project(self.path, robot, self.lengths)
+        return float(self.lengths[-1]) - s0 + off
 
     def replan_reason(self, robot: Vec, stamp: float) -> str | None:
         """Why the global path must be planned again now, or None. Obstacles in the
@@ -934,13 +955,13 @@ class Planner:
             return "retry" if stamp - self.last_replan >= p.replan_period else None
         if self.detour is not None:
             return None
-        s0, off = project(self.path, robot)
+        s0, off = project(self.path, robot, self.lengths)
         if off > p.path_deviation:
             return "off the path"
         if stamp - self.last_replan < p.replan_period:
             return None
         beyond = first_blocked(self.costmap, self.path, s0 + p.window_radius,
-                               p.map_resolution)
+                               p.map_resolution, self.lengths)
         if beyond is not None:
             return "blocked beyond the window"
         return None

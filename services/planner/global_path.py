@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from zenav.services.planner._loops import point_on, project_on
 from zenav.services.planner.costmap import Costmap
 from zenav.services.planner.field import grid_distances
 
@@ -197,38 +198,35 @@ def arc_lengths(points: Vec) -> Vec:
     return out
 
 
-def project(points: Vec, p: Vec) -> tuple[float, float]:
-    """(s, d): arc length of the point of the path nearest ``p``, and the distance."""
-    a, b = points[:-1], points[1:]
-    ab = b - a
-    l2 = np.maximum((ab * ab).sum(axis=1), 1e-18)
-    t = np.clip(((p[None, :] - a) * ab).sum(axis=1) / l2, 0.0, 1.0)
-    near = a + t[:, None] * ab
-    d = np.hypot(*(near - p[None, :]).T)
-    k = int(np.argmin(d))
-    s = arc_lengths(points)
-    return float(s[k] + t[k] * math.sqrt(l2[k])), float(d[k])
+def project(points: Vec, p: Vec, lengths: Vec | None = None) -> tuple[float, float]:
+    """(s, d): arc length of the point of the path nearest ``p``, and the distance; in
+    compiled code (``_loops.project_on``), segment by segment. ``lengths``: the path's
+    ``arc_lengths``, when the caller keeps them."""
+    s = arc_lengths(points) if lengths is None else lengths
+    return project_on(np.ascontiguousarray(points, dtype=np.float64), s, float(p[0]),
+                      float(p[1]))
 
 
-def point_at(points: Vec, s: float) -> Vec:
-    """The point of the path at arc length ``s`` (clamped to its ends)."""
-    lengths = arc_lengths(points)
-    s = min(max(s, 0.0), float(lengths[-1]))
-    k = int(np.searchsorted(lengths, s, side="right") - 1)
-    k = min(k, len(points) - 2)
-    seg = float(lengths[k + 1] - lengths[k])
-    t = 0.0 if seg < 1e-12 else (s - float(lengths[k])) / seg
-    return np.asarray(points[k] + t * (points[k + 1] - points[k]), dtype=np.float64)
+def point_at(points: Vec, s: float, lengths: Vec | None = None) -> Vec:
+    """The point of the path at arc length ``s`` (clamped to its ends); ``lengths`` as
+    for :func:`project`; in compiled code (``_loops.point_on``)."""
+    if lengths is None:
+        lengths = arc_lengths(points)
+    return np.array(point_on(np.ascontiguousarray(points, dtype=np.float64), lengths,
+                             float(s)), dtype=np.float64)
 
 
-def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float) -> float | None:
+def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float,
+                  lengths: Vec | None = None) -> float | None:
     """Arc length of the first point of the path, at or beyond ``from_s``, that lies in
-    a blocked cell or beyond the grid; None if the rest of the path is free."""
-    total = float(arc_lengths(points)[-1])
+    a blocked cell or beyond the grid; None if the rest of the path is free. ``lengths``
+    as for :func:`project`."""
+    if lengths is None:
+        lengths = arc_lengths(points)
+    total = float(lengths[-1])
     if from_s >= total:
         return None
     s = np.arange(from_s, total + step / 2, step)
-    lengths = arc_lengths(points)
     samples = np.column_stack([np.interp(s, lengths, points[:, 0]),
                                np.interp(s, lengths, points[:, 1])])
     hit = costmap.blocked_at(samples, outside=True)

@@ -128,10 +128,15 @@ def gap_to_boxes(points: Vec, lows: Vec, highs: Vec) -> Vec:
     return np.asarray(np.hypot(outside[..., 0], outside[..., 1]).min(axis=1), dtype=np.float64)
 
 
+def path_count(length: float, step: float) -> int:
+    """How many points :func:`path_points` puts along ``length`` m every ``step`` m."""
+    return max(2, math.ceil(length / step) + 1)
+
+
 def path_points(start: Vec, direction: Vec, length: float, step: float) -> Vec:
-    """Points every ``step`` m along a straight path, both ends included."""
-    count = max(2, math.ceil(length / step) + 1)
-    s = np.linspace(0.0, length, count)
+    """Points every ``step`` m along a straight path, both ends included. (The compiled
+    loops ``_loops.box_gaps`` and ``_loops.line_any`` make the same points themselves.)"""
+    s = np.linspace(0.0, length, path_count(length, step))
     return start[None, :] + s[:, None] * direction[None, :]
 
 
@@ -148,12 +153,10 @@ def line_crossing(d: Point, rel: Point, u: Point) -> tuple[float, float] | None:
 
 
 def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
-                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment | None:
-    """(b) for a standing obstacle, from the gaps (m, clearance taken off) between its grid
-    area and each of the ``count`` points along the path: ``first``, the index of the
-    first negative one (-1: none, then None), and ``least``, the smallest."""
-    if first < 0:
-        return None
+                 obstacle: Obstacle, first: int, least: float, count: int) -> Assessment:
+    """(b) for a standing obstacle on the path, from the gaps (m, clearance taken off)
+    between its grid area and each of the ``count`` points along the path: ``first``,
+    the index of the first negative one, and ``least``, the smallest."""
     along = float((np.asarray(obstacle.position, dtype=np.float64) - robot) @ direction)
     s_hit = first * path_length / (count - 1)
     centre_s = min(max(along, 0.0), path_length)
@@ -162,10 +165,6 @@ def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
     return Assessment(obstacle, "b", True, (rx + dx * centre_s, ry + dy * centre_s), s_hit,
                       s_hit / speed if speed > 0 else math.inf, math.inf, least, along, 0.0,
                       (dx, dy))
-
-
-def _moving(obstacle: Obstacle, moving_speed: float) -> bool:
-    return obstacle.kind == "dynamic" and c_hypot(*obstacle.velocity) >= moving_speed
 
 
 def _row_dots(a: Vec, b: Vec) -> list[float]:
@@ -240,23 +239,29 @@ def assess_all(
     """:func:`assess` for every obstacle (``margins``, ``horizons`` and ``following`` one
     per obstacle), the ones with something to do with the path, in order (``assess`` is
     this for one obstacle; each answer is the one it gets alone, to the last bit). The standing
-    obstacles are measured against the path all at once: one set of path points, every
-    grid area's gaps in one compiled loop (``_loops.box_gaps``). The movers' vectors are
+    obstacles are measured against the path all at once: the path's points
+    (:func:`path_points`) and every grid area's gaps in one compiled loop
+    (``_loops.box_gaps``). The movers' vectors are
     arrays of all of them, their dot products taken in one call each; the rest is
     arithmetic on plain numbers, mover by mover."""
-    standing = [i for i, ob in enumerate(obstacles) if not _moving(ob, moving_speed)]
-    found: dict[int, Assessment | None] = {}
+    speeds = [c_hypot(*ob.velocity) for ob in obstacles]
+    standing = [i for i, ob in enumerate(obstacles)
+                if ob.kind != "dynamic" or speeds[i] < moving_speed]
+    found: list[Assessment | None] = [None] * len(obstacles)
     if standing:
-        points = path_points(robot, direction, path_length, cell / 4)
+        count = path_count(path_length, cell / 4)
         first = np.empty(len(standing), dtype=np.int64)
         least = np.empty(len(standing), dtype=np.float64)
-        box_gaps(points, np.array([obstacles[i].cells for i in standing], dtype=np.int64),
-                 cell, np.array([robot_radius + margins[i] for i in standing],
-                                dtype=np.float64), first, least)
+        box_gaps(float(robot[0]), float(robot[1]), float(direction[0]), float(direction[1]),
+                 path_length, count,
+                 np.array([obstacles[i].cells for i in standing], dtype=np.int64), cell,
+                 np.array([robot_radius + margins[i] for i in standing], dtype=np.float64),
+                 first, least)
         for i, hit, smallest in zip(standing, first.tolist(), least.tolist(), strict=True):
-            found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i], hit,
-                                    smallest, len(points))
-    moving = [i for i in range(len(obstacles)) if i not in found]
+            if hit >= 0:
+                found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i],
+                                        hit, smallest, count)
+    moving = sorted(set(range(len(obstacles))).difference(standing))
     if moving:
         # The movers' vectors as arrays, their dot products all at once, the rest per mover.
         rel = np.array([obstacles[i].position for i in moving], dtype=np.float64) - robot
@@ -272,11 +277,11 @@ def assess_all(
             t_path = min(horizons[i], path_length / speed) if speed > 0 else horizons[i]
             found[i] = _mover(
                 robot_xy, heading, speed, path_length, ob, (rx, ry), along[k], along_speed[k],
-                c_hypot(*ob.velocity),
+                speeds[i],
                 closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
                 robot_radius + ob.radius + margins[i], head_on_cos=head_on_cos,
                 same_way_cos=same_way_cos, meet_rule=meet_rule, following=following[i])
-    return [a for i in range(len(obstacles)) if (a := found[i]) is not None]
+    return [a for a in found if a is not None]
 
 
 def assess(

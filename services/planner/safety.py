@@ -49,6 +49,9 @@ from zenav.services.geometry import wrap_angle, wrap_angles
 from zenav.services.planner._loops import contacts, drive
 
 Vec = npt.NDArray[np.float64]
+Blocked = Callable[[Vec, Vec], npt.NDArray[np.bool_]]
+"""The map's check: for each row of points (``xs[i]``, ``ys[i]``), whether any lies where
+the map holds something (``Costmap.blocked_rows``)."""
 
 
 @dataclass(frozen=True)
@@ -150,12 +153,11 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
 
 
 def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: Vec,
-           blocked: Callable[[Vec], npt.NDArray[np.bool_]] | None, last_heading: float | None,
-           s: Settings) -> Choice:
+           blocked: Blocked | None, last_heading: float | None, s: Settings) -> Choice:
     """Check the local layer's ``proposal`` (heading rad, speed m/s) and keep it if its
     roll-out touches no mover within the horizon; else the cheapest candidate. ``carrot``:
-    the point on the global path progress is measured to; ``blocked``: which points the
-    map holds (None: no map)."""
+    the point on the global path progress is measured to; ``blocked``: which roll-outs
+    pass a point the map holds (None: no map)."""
     heading, speed = proposal
     steps = max(round(s.horizon / s.step), 1)
     times = s.step * np.arange(1, steps + 1, dtype=np.float64)
@@ -181,16 +183,13 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
 
 
 def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
-           blocked: Callable[[Vec], npt.NDArray[np.bool_]] | None, s: Settings
+           blocked: Blocked | None, s: Settings
            ) -> tuple[Vec, Vec, Vec, Vec, npt.NDArray[np.int64]]:
     """Roll out each candidate and score its passes by the movers and the map: the
     positions (n, k), the cost, the time of the first contact and its mover."""
     xs, ys = rollout(robot, headings, speeds, times)
     cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
-    if blocked is not None:
-        walls = blocked(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
-        start_blocked = bool(blocked(np.array([[robot.x, robot.y]]))[0])
-        if not start_blocked:  # inside the inflation already: the map cannot judge
-            hit = walls.any(axis=1)
-            cost = cost + np.where(hit, 10.0, 0.0)
+    # Inside the inflation already, the map cannot judge.
+    if blocked is not None and not blocked(np.array([[robot.x]]), np.array([[robot.y]]))[0]:
+        cost = cost + np.where(blocked(xs, ys), 10.0, 0.0)
     return xs, ys, cost, first_t, who

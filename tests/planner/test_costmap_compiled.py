@@ -14,6 +14,7 @@ from scipy.ndimage import distance_transform_edt
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import floor_quotients
 from zenav.services.planner.costmap import Costmap, ScanData
+from zenav.services.planner.prediction import path_count, path_points
 
 Mover = tuple[float, float, float]
 
@@ -209,3 +210,45 @@ def test_the_blocked_cells_are_those_within_the_inflation_by_the_distance_transf
     expected = np.asarray(distance_transform_edt(~lethal), dtype=np.float64) * 0.1
     assert np.array_equal(cm.blocked(), expected <= inflation)
     assert cm.gap().tobytes() == expected.tobytes()
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_blocked_along_looks_up_the_points_of_path_points(seed: int) -> None:
+    """``blocked_along`` (compiled ``line_any``, making the points itself) is
+    ``blocked_at`` of ``path_points``' points, ``any``: lines across a map with walls,
+    into and beyond the grid, and of length 0."""
+    rng = np.random.default_rng(seed)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
+                       math.pi / 180, 8.0), 0.0)
+    hits = 0
+    for _ in range(50):
+        start = rng.uniform(-2.0, 6.0, 2)
+        heading = rng.uniform(-math.pi, math.pi)
+        direction = np.array([math.cos(heading), math.sin(heading)])
+        length = 0.0 if rng.random() < 0.1 else float(rng.uniform(0.05, 6.0))
+        step = float(rng.choice([0.05, 0.025]))
+        want = bool(cm.blocked_at(path_points(start, direction, length, step)).any())
+        got = cm.blocked_along((float(start[0]), float(start[1])),
+                               (float(direction[0]), float(direction[1])), length,
+                               path_count(length, step))
+        assert got == want
+        hits += want
+    assert 0 < hits < 50
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
+    """``blocked_rows`` (compiled ``look_up_rows``) is ``blocked_at`` of every point, any
+    per row: rows of points inside and beyond the grid."""
+    rng = np.random.default_rng(seed)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
+                       math.pi / 180, 8.0), 0.0)
+    xs, ys = rng.uniform(-3.0, 8.0, (300, 12)), rng.uniform(-3.0, 8.0, (300, 12))
+    want = cm.blocked_at(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
+    got = cm.blocked_rows(xs, ys)
+    assert np.array_equal(got, want.any(axis=1))
+    assert got.any() and not got.all()

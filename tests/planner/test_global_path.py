@@ -12,7 +12,14 @@ import pytest
 
 from tests.planner.scans import cup, scan_of, wall_with_gap
 from zenav.services.planner.costmap import Costmap
-from zenav.services.planner.global_path import first_blocked, plan_path, visible
+from zenav.services.planner.global_path import (
+    arc_lengths,
+    first_blocked,
+    plan_path,
+    point_at,
+    project,
+    visible,
+)
 
 START = np.array([0.0, 4.0])
 GOAL = np.array([8.0, 4.0])
@@ -156,3 +163,65 @@ def test_a_start_in_the_inflation_is_joined_to_free_space_on_its_side_of_a_thin_
     plan = plan_path(cm, robot, np.array([-3.0, 2.0]))
     assert plan.found
     assert not any(crosses(plan.points, box) for box in walls)
+
+
+def numpy_project(points: np.ndarray, p: np.ndarray) -> tuple[float, float]:
+    """The projection as numpy array operations (the code ``project_on`` replaced)."""
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    l2 = np.maximum((ab * ab).sum(axis=1), 1e-18)
+    t = np.clip(((p[None, :] - a) * ab).sum(axis=1) / l2, 0.0, 1.0)
+    near = a + t[:, None] * ab
+    d = np.hypot(*(near - p[None, :]).T)
+    k = int(np.argmin(d))
+    s = arc_lengths(points)
+    return float(s[k] + t[k] * math.sqrt(l2[k])), float(d[k])
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_project_is_the_numpy_projection_to_the_bit(seed: int) -> None:
+    """``project`` (compiled, with the arc lengths given or not) against the numpy code it
+    replaced: random polylines, some with repeated vertices (zero-length segments), and
+    points on them, beside them, at a vertex and far off."""
+    rng = np.random.default_rng(seed)
+    for _ in range(100):
+        points = rng.uniform(-5.0, 5.0, (int(rng.integers(2, 9)), 2))
+        if rng.random() < 0.3:
+            points[1] = points[0]
+        p = rng.uniform(-8.0, 8.0, 2) if rng.random() < 0.8 else points[-1].copy()
+        want = numpy_project(points, p)
+        assert project(points, p) == want
+        assert project(points, p, arc_lengths(points)) == want
+
+
+def test_project_needs_a_path_of_two_points() -> None:
+    with pytest.raises(ValueError):
+        project(np.array([[0.0, 0.0]]), np.array([1.0, 1.0]))
+
+
+def numpy_point_at(points: np.ndarray, s: float) -> np.ndarray:
+    """The point at an arc length as numpy operations (the code ``point_on`` replaced)."""
+    lengths = arc_lengths(points)
+    s = min(max(s, 0.0), float(lengths[-1]))
+    k = int(np.searchsorted(lengths, s, side="right") - 1)
+    k = min(k, len(points) - 2)
+    seg = float(lengths[k + 1] - lengths[k])
+    t = 0.0 if seg < 1e-12 else (s - float(lengths[k])) / seg
+    return np.asarray(points[k] + t * (points[k + 1] - points[k]), dtype=np.float64)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_point_at_is_the_numpy_point_to_the_bit(seed: int) -> None:
+    """``point_at`` (compiled) against the numpy code it replaced: random polylines with
+    repeated vertices now and then, arc lengths before the start, at every vertex, in
+    between and past the end."""
+    rng = np.random.default_rng(seed)
+    for _ in range(100):
+        points = rng.uniform(-5.0, 5.0, (int(rng.integers(2, 9)), 2))
+        if rng.random() < 0.3:
+            points[int(rng.integers(1, len(points)))] = points[0]
+        lengths = arc_lengths(points)
+        for s in [*lengths.tolist(), *rng.uniform(-1.0, float(lengths[-1]) + 1.0, 5)]:
+            want = numpy_point_at(points, s).tobytes()
+            assert point_at(points, s).tobytes() == want
+            assert point_at(points, s, lengths).tobytes() == want

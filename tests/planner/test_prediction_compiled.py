@@ -1,6 +1,7 @@
 """The collision prediction's faster arithmetic gives, to the bit, the numbers of the
 numpy code it replaced: the compiled gap of path points to grid boxes
-(``_loops.box_gaps``, what ``prediction.assess_all`` calls for the standing obstacles),
+(``_loops.box_gaps``, what ``prediction.assess_all`` calls for the standing obstacles,
+making the points of ``path_points`` itself),
 the C library's ``hypot`` for two numbers (``_loops.c_hypot``) and the movers' dot
 products taken all at once (``prediction._row_dots``)."""
 
@@ -29,16 +30,26 @@ def numpy_box_gaps(points: np.ndarray, cells: np.ndarray, cell: float,
     return first, every.min(axis=0).tolist()
 
 
+Line = tuple[np.ndarray, np.ndarray, float]
 Case = tuple[np.ndarray, np.ndarray, float, np.ndarray]
+
+
+def random_line(seed: int) -> tuple[Line, float]:
+    """A random straight path (start, unit direction, length; now and then of length 0)
+    and a cell size."""
+    rng = np.random.default_rng(seed)
+    cell = float(rng.choice([0.05, 0.1, 0.25]))
+    heading = rng.uniform(-np.pi, np.pi)
+    length = 0.0 if seed % 10 == 9 else float(rng.uniform(0.1, 6.0))
+    return (rng.uniform(-2.0, 2.0, 2), np.array([np.cos(heading), np.sin(heading)]),
+            length), cell
 
 
 def random_case(seed: int) -> Case:
     """Points along a random path, random grid boxes round it and their clearances."""
-    rng = np.random.default_rng(seed)
-    cell = float(rng.choice([0.05, 0.1, 0.25]))
-    heading = rng.uniform(-np.pi, np.pi)
-    points = path_points(rng.uniform(-2.0, 2.0, 2), np.array([np.cos(heading), np.sin(heading)]),
-                         rng.uniform(0.1, 6.0), cell / 4)
+    (start, direction, length), cell = random_line(seed)
+    points = path_points(start, direction, length, cell / 4)
+    rng = np.random.default_rng(seed + 1000)
     count = int(rng.integers(1, 25))
     lows = np.column_stack([rng.integers(-60, 60, count), rng.integers(-60, 60, count)])
     sizes = rng.integers(0, 6, (count, 2))
@@ -50,9 +61,11 @@ def random_case(seed: int) -> Case:
 @pytest.mark.parametrize("seed", range(30))
 def test_box_gaps_is_the_numpy_arithmetic(seed: int) -> None:
     points, cells, cell, clearances = random_case(seed)
+    (start, direction, length), _ = random_line(seed)
     first = np.empty(len(cells), dtype=np.int64)
     least = np.empty(len(cells), dtype=np.float64)
-    box_gaps(points, cells, cell, clearances, first, least)
+    box_gaps(*start.tolist(), *direction.tolist(), length, len(points), cells, cell,
+             clearances, first, least)
     want_first, want_least = numpy_box_gaps(points, cells, cell, clearances)
     assert first.tolist() == want_first
     assert least.tobytes() == np.array(want_least, dtype=np.float64).tobytes()

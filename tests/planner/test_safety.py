@@ -117,8 +117,9 @@ def test_a_walker_crossing_just_ahead_is_not_driven_into() -> None:
 def test_the_map_rules_out_headings_into_a_wall() -> None:
     # Everything at x > 0.8 is a wall; a walker comes from behind. The robot goes
     # sideways or back, never forward into the wall.
-    def wall(points: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]:
-        return np.asarray(points[:, 0] > 0.8)
+    def wall(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64]
+             ) -> npt.NDArray[np.bool_]:
+        return np.asarray((xs > 0.8).any(axis=1))
 
     choice = safety.choose(robot(), (0.0, 0.0), movers((-3.0, 0.0, 1.0, 0.0)),
                            np.array([6.0, 0.0]), wall, None, SETTINGS)
