@@ -8,11 +8,13 @@ import argparse
 import os
 import sys
 
-LIGHT = ("service", "router")
-"""Commands a supervisor restarts after a crash: their parser is built alone, without
-importing every other command (the benchmarks pull in scipy and matplotlib), because a
-restarted service's start-up time is the robot's outage (15-25 s against 4.5 s on a
-loaded 2-core machine)."""
+LIGHT = ("service", "router", "run", "schemas")
+"""Commands whose parser is built alone, without importing every other command (the
+benchmarks pull in scipy and matplotlib: about 1 s of a 2-core machine). A supervisor
+restarts ``service`` and ``router`` after a crash, and a restarted service's start-up time
+is the robot's outage (15-25 s against 4.5 s on a loaded 2-core machine); ``run`` (with
+``schemas``, its neighbour in :mod:`zenav.stackcmd`) is the command people and the
+benchmarks repeat, and that second was a fifth of a whole run."""
 
 
 def build_light_parser(command: str) -> argparse.ArgumentParser:
@@ -28,7 +30,7 @@ def build_light_parser(command: str) -> argparse.ArgumentParser:
     else:
         from zenav import stackcmd
 
-        stackcmd.add_commands(sub)
+        stackcmd.add_commands(sub)  # run, service, schemas
     return parser
 
 
