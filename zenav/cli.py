@@ -5,6 +5,7 @@ function ``main`` calls with the parsed arguments."""
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 
@@ -70,9 +71,14 @@ def main(argv: list[str] | None = None) -> int:
         code = _main(argv)
     except KeyboardInterrupt:
         code = 130
+    from zenav.services.runner import closed_cleanly
+    from zenav.services.runner import still_opening as service_opening
     from zenav.tooling import still_opening
 
-    if still_opening():  # stopped while connecting: skip a teardown that stalls for seconds
+    # Stopped while connecting, the interpreter's teardown stalls for seconds in Zenoh's;
+    # after a service's clean stop it has nothing left to do but free memory.
+    if still_opening() or service_opening() or closed_cleanly():
+        logging.shutdown()
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
