@@ -208,11 +208,12 @@ def still_opening() -> bool:
 
 class SessionOpening:
     """A Zenoh session being opened on a thread of its own, started before the service
-    loads its parameter model and its modules. In peer mode ``zenoh.open`` returns only
-    after its scouting delay (half a second by default), the time it gives the links to
-    the other peers to come up; those imports fill it instead of coming after it. The
-    session is the same as one opened in place: nothing is declared on it before it is
-    open, so a service is no sooner alive, nor less connected, than before."""
+    loads its modules (the planner's and the tracker's pull in scipy). In peer mode
+    ``zenoh.open`` returns only once it is linked to every peer it connects to, or after
+    its scouting delay (half a second by default) when some are not up yet: time those
+    imports now fill instead of following. The session is the same as one opened in
+    place: nothing is declared on it before it is open, so a service is no sooner alive,
+    nor less connected, than before."""
 
     def __init__(self, transport: TransportConfig) -> None:
         self._future: concurrent.futures.Future[Any] = concurrent.futures.Future()
@@ -314,29 +315,20 @@ def main(name: str, argv: list[str] | None = None) -> int:
     add_standby_argument(parser)
     args = parser.parse_args(argv)
     setup_logging(args.log_level, name)
-
-    def say(exc: Exception) -> int:
-        for line in str(exc).splitlines():  # one line per problem, each naming the service
-            print(f"zenav {name}: {line}", file=sys.stderr)
-        return 2
+    from zenav.schemas.keys import Keys, check_robot_id
 
     try:
         planner = getattr(args, "planner", "paper")
-        transport = transport_from_args(args, name)
-    except (ConfigError, ValueError) as exc:
-        return say(exc)
-    # A warm spare stays off the bus until it takes over; any other service opens its
-    # session while it loads the rest.
-    opening = SessionOpening(transport) if args.standby_lock is None else None
-    from zenav.schemas.keys import Keys, check_robot_id  # the messages: numpy, pydantic
-
-    try:
         params = load_params(service_params(name, planner), args.config, args.set)
         keys = Keys(check_robot_id(args.robot_id))
+        transport = transport_from_args(args, name)
     except (ConfigError, ValueError) as exc:
-        if opening is not None:
-            opening.abandon()
-        return say(exc)
+        for line in str(exc).splitlines():  # one line per problem, each naming the service
+            print(f"zenav {name}: {line}", file=sys.stderr)
+        return 2
+    # Its input known good, the service opens its session while it loads its modules (a
+    # warm spare stays off the bus until it takes over).
+    opening = SessionOpening(transport) if args.standby_lock is None else None
     if args.standby_lock is not None:
         try:
             implementation(name, planner)  # everything loaded before waiting: a warm spare

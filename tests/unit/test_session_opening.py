@@ -58,3 +58,13 @@ def test_an_abandoned_opening_closes_its_session_and_leaves_nothing_opening() ->
     session = opened._future.result(timeout=1)
     opened.abandon()  # opened, then abandoned: closed here
     assert session.is_closed()
+
+
+def test_a_service_given_bad_input_opens_no_session(capsys: pytest.CaptureFixture[str]) -> None:
+    """The input is checked before the session starts opening: exit 2 with the reason,
+    and nothing left opening (the ``zenav`` command would end such a process at once)."""
+    assert runner.main("tracking", ["--set", "no_such_parameter=1", "--base-port",
+                                    str(free_port_block(7))]) == 2
+    assert "no_such_parameter" in capsys.readouterr().err
+    assert not runner.still_opening()
+    assert not runner.closed_cleanly()
