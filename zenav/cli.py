@@ -5,14 +5,17 @@ function ``main`` calls with the parsed arguments."""
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 
-LIGHT = ("service", "router")
-"""Commands a supervisor restarts after a crash: their parser is built alone, without
-importing every other command (the benchmarks pull in scipy and matplotlib), because a
-restarted service's start-up time is the robot's outage (15-25 s against 4.5 s on a
-loaded 2-core machine)."""
+LIGHT = ("service", "router", "run", "schemas")
+"""Commands whose parser is built alone, without importing every other command (the
+benchmarks pull in scipy and matplotlib: about 1 s of a 2-core machine). A supervisor
+restarts ``service`` and ``router`` after a crash, and a restarted service's start-up time
+is the robot's outage (15-25 s against 4.5 s on a loaded 2-core machine); ``run`` (with
+``schemas``, its neighbour in :mod:`zenav.stackcmd`) is the command people and the
+benchmarks repeat, and that second was a fifth of a whole run."""
 
 
 def build_light_parser(command: str) -> argparse.ArgumentParser:
@@ -28,7 +31,7 @@ def build_light_parser(command: str) -> argparse.ArgumentParser:
     else:
         from zenav import stackcmd
 
-        stackcmd.add_commands(sub)
+        stackcmd.add_commands(sub)  # run, service, schemas
     return parser
 
 
@@ -68,9 +71,14 @@ def main(argv: list[str] | None = None) -> int:
         code = _main(argv)
     except KeyboardInterrupt:
         code = 130
+    from zenav.services.runner import closed_cleanly
+    from zenav.services.runner import still_opening as service_opening
     from zenav.tooling import still_opening
 
-    if still_opening():  # stopped while connecting: skip a teardown that stalls for seconds
+    # Stopped while connecting, the interpreter's teardown stalls for seconds in Zenoh's;
+    # after a service's clean stop it has nothing left to do but free memory.
+    if still_opening() or service_opening() or closed_cleanly():
+        logging.shutdown()
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
