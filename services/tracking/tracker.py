@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -50,7 +51,6 @@ from zenav.services.perception.clustering import (
     EDGE_FREE,
     EDGE_OCCLUDED,
     Clusters,
-    box_area,
     to_global,
 )
 from zenav.services.tracking.correlation import (
@@ -78,9 +78,10 @@ _PIECE_BEAMS = 3
 _STAMP_SLACK = 1e-6
 
 
-@dataclass(frozen=True)
-class Track:
-    """One tracked obstacle as output by :meth:`Tracker.update`.
+class Track(NamedTuple):
+    """One tracked obstacle as output by :meth:`Tracker.update` (an immutable record; a
+    named tuple, which costs a fraction of a frozen dataclass to build, once per track and
+    scan).
 
     Attributes:
         id: persistent id, unique over the tracker's life (1, 2, ...).
@@ -196,10 +197,21 @@ class _Rows:
     moved: list[float] | None
     moved_each: list[list[float]] | None
     moved_refs: list[float] | None
+    # The score against every earlier scan compared with (numpy's masked maximum, nan if
+    # any is), and the oldest of those scans' stamps (inf: none): a track born before
+    # that takes the first, without a loop over the scans per track.
+    moved_all: list[float] | None
+    oldest_ref: float
 
     @staticmethod
     def of(clusters: Clusters) -> _Rows:
         each, refs = clusters.moved_each, clusters.moved_refs
+        moved_all, oldest_ref = None, math.inf
+        if each is not None and refs is not None:
+            finite = np.isfinite(refs)
+            moved_all = each[:, finite].max(axis=1, initial=0.0).tolist()
+            if finite.any():
+                oldest_ref = float(refs[finite].min())
         return _Rows(
             centre=[(x, y) for x, y in clusters.centre.tolist()],
             chord_centre=[(x, y) for x, y in clusters.chord_centre.tolist()],
@@ -215,6 +227,7 @@ class _Rows:
             moved=clusters.moved.tolist() if clusters.moved is not None else None,
             moved_each=each.tolist() if each is not None and refs is not None else None,
             moved_refs=refs.tolist() if each is not None and refs is not None else None,
+            moved_all=moved_all, oldest_ref=oldest_ref,
         )  # fmt: skip
 
 
@@ -228,6 +241,8 @@ def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
     if rows.moved_each is None or rows.moved_refs is None:
         return rows.moved[c] if rows.moved is not None else 0.0
     limit = born - 1e-9
+    if limit <= rows.oldest_ref and rows.moved_all is not None:
+        return rows.moved_all[c]  # every scan compared with was taken since
     best = 0.0
     for ref, score in zip(rows.moved_refs, rows.moved_each[c], strict=True):
         if math.isfinite(ref) and ref >= limit:
@@ -240,6 +255,12 @@ def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
 def _union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
     """The grid box holding both boxes (ix_min, ix_max, iy_min, iy_max)."""
     return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
+
+
+def _cells(box: tuple[int, int, int, int]) -> int:
+    """Eq. 6 for one box of Python ints: the cells in it, as ``box_area`` counts them
+    (without the cost of a numpy call for four numbers)."""
+    return (box[1] - box[0] + 1) * (box[3] - box[2] + 1)
 
 
 class Tracker:
@@ -327,7 +348,9 @@ class Tracker:
                     self._correct(t, m)
             was_static = t.kind == "static"
             if clusters.moved is not None:
-                moved = max(_moved_since_born(rows, c, t.born) for c in members[ti])
+                cl = members[ti]
+                moved = (_moved_since_born(rows, cl[0], t.born) if len(cl) == 1
+                         else max(_moved_since_born(rows, c, t.born) for c in cl))
                 if moved >= p.moved_threshold:
                     t.last_moved = stamp
             if smoothed:
@@ -353,7 +376,7 @@ class Tracker:
                 # in front or by the window edge neither grows nor shrinks it.
                 if not m.partial:
                     t.box = _union(t.box, m.box)
-                    t.area = int(box_area(t.box))
+                    t.area = _cells(t.box)
                     t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
@@ -565,7 +588,7 @@ class Tracker:
             point=(cx, cy) if use_chord else centre,
             radius=radius,
             box=box,
-            area=int(box_area(np.array(box))),  # Eq. 6
+            area=_cells(box),  # Eq. 6
             partial=bool(
                 clusters.edge_start[first] != EDGE_FREE or clusters.edge_end[last] != EDGE_FREE
             ),
