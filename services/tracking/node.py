@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Sequence
 
 from pydantic import TypeAdapter
 
@@ -20,8 +20,10 @@ from zenav.services.tracking.tracker import Tracker
 _TRACK_LIST = TypeAdapter(list[Track])
 
 
-def track_messages(tracks: Iterable[TrackState]) -> list[Track]:
+def track_messages(tracks: Sequence[TrackState]) -> list[Track]:
     """The bus messages of a frame's tracks (the paper quantities clamped to their ranges)."""
+    if not tracks:
+        return []  # (the validator's call costs more than the empty list)
     return _TRACK_LIST.validate_python(
         [
             {

@@ -197,21 +197,10 @@ class _Rows:
     moved: list[float] | None
     moved_each: list[list[float]] | None
     moved_refs: list[float] | None
-    # The score against every earlier scan compared with (numpy's masked maximum, nan if
-    # any is), and the oldest of those scans' stamps (inf: none): a track born before
-    # that takes the first, without a loop over the scans per track.
-    moved_all: list[float] | None
-    oldest_ref: float
 
     @staticmethod
     def of(clusters: Clusters) -> _Rows:
         each, refs = clusters.moved_each, clusters.moved_refs
-        moved_all, oldest_ref = None, math.inf
-        if each is not None and refs is not None:
-            finite = np.isfinite(refs)
-            moved_all = each[:, finite].max(axis=1, initial=0.0).tolist()
-            if finite.any():
-                oldest_ref = float(refs[finite].min())
         return _Rows(
             centre=[(x, y) for x, y in clusters.centre.tolist()],
             chord_centre=[(x, y) for x, y in clusters.chord_centre.tolist()],
@@ -227,7 +216,6 @@ class _Rows:
             moved=clusters.moved.tolist() if clusters.moved is not None else None,
             moved_each=each.tolist() if each is not None and refs is not None else None,
             moved_refs=refs.tolist() if each is not None and refs is not None else None,
-            moved_all=moved_all, oldest_ref=oldest_ref,
         )  # fmt: skip
 
 
@@ -241,8 +229,6 @@ def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
     if rows.moved_each is None or rows.moved_refs is None:
         return rows.moved[c] if rows.moved is not None else 0.0
     limit = born - 1e-9
-    if limit <= rows.oldest_ref and rows.moved_all is not None:
-        return rows.moved_all[c]  # every scan compared with was taken since
     best = 0.0
     for ref, score in zip(rows.moved_refs, rows.moved_each[c], strict=True):
         if math.isfinite(ref) and ref >= limit:
@@ -328,13 +314,18 @@ class Tracker:
         centres = np.array([meas[i].centre for i in order], dtype=np.float64).reshape(-1, 2)
         boxes = np.array([meas[i].box for i in order], dtype=np.int64).reshape(-1, 4)
         ref_stamp, ref_centres, ref_boxes = self._reference(stamp)
-        corr = correlate(
-            centres, boxes, ref_centres, ref_boxes,
-            cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
-        )  # fmt: skip
-        best = best_match(corr)
-        best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
-        best_delta, best_index = best.delta.tolist(), best.index.tolist()
+        best_xi: list[float] = []
+        best_varsigma: list[float] = []
+        best_delta: list[float] = []
+        best_index: list[int] = []
+        if order:  # (a frame without obstacles has nothing to compare)
+            corr = correlate(
+                centres, boxes, ref_centres, ref_boxes,
+                cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
+            )  # fmt: skip
+            best = best_match(corr)
+            best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
+            best_delta, best_index = best.delta.tolist(), best.index.tolist()
 
         for row, ti in enumerate(order):
             t = self._tracks[ti]
