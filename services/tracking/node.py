@@ -51,11 +51,6 @@ def track_messages(tracks: Sequence[TrackState]) -> list[Track]:
     )
 
 
-def track_message(track: TrackState) -> Track:
-    """The bus message of one track (:func:`track_messages` of one)."""
-    return track_messages((track,))[0]
-
-
 class Service:
     def __init__(self, node: Node, params: TrackingParams) -> None:
         self.node = node
