@@ -11,6 +11,7 @@ meaning and the equations (Eq. 3's threshold comes in as an array from
 import numpy as np
 
 from libc.math cimport INFINITY, atan2, hypot, rint, sqrt
+from libc.stdlib cimport calloc, free
 
 include "../_angles.pxi"
 
@@ -105,35 +106,44 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
     cdef double px, py, share
     cdef bint vacated = False
     cdef bint tested
-    cdef long[::1] entered = np.zeros(n, dtype=np.int64)
-    cdef long[::1] near = np.zeros(n, dtype=np.int64)
-    cdef long[::1] gone = np.zeros(n, dtype=np.int64)
-    for i in range(points.shape[0]):
-        if free_at(points[i, 0], points[i, 1], past_x, past_y, past_heading, past_ranges,
-                   past_angle_min, past_angle_increment, margin):
-            entered[member[i]] += 1
-    for c in range(n):
-        scores[c] = <double>entered[c] / <double>counts[c] if counts[c] > 0 else 0.0
-    if past_points.shape[0] < 2:
-        return
-    for i in range(past_points.shape[0]):
-        px = past_points[i, 0]
-        py = past_points[i, 1]
-        tested = False  # the free-space test only for a point inside some box
+    # Three counters per cluster in one C buffer (numpy arrays cost more to make than
+    # the loops below take on a chain of a few clusters).
+    cdef long *entered = <long *> calloc(3 * n + 1, sizeof(long))
+    cdef long *near
+    cdef long *gone
+    if entered == NULL:
+        raise MemoryError()
+    near = entered + n
+    gone = near + n
+    try:
+        for i in range(points.shape[0]):
+            if free_at(points[i, 0], points[i, 1], past_x, past_y, past_heading, past_ranges,
+                       past_angle_min, past_angle_increment, margin):
+                entered[member[i]] += 1
         for c in range(n):
-            if lo[c, 0] <= px <= hi[c, 0] and lo[c, 1] <= py <= hi[c, 1]:
-                if not tested:
-                    vacated = free_at(px, py, x, y, heading, ranges, angle_min,
-                                      angle_increment, margin)
-                    tested = True
-                near[c] += 1
-                if vacated:
-                    gone[c] += 1
-    for c in range(n):
-        if near[c] >= 2:
-            share = <double>gone[c] / <double>near[c]
-            if share > scores[c]:
-                scores[c] = share
+            scores[c] = <double>entered[c] / <double>counts[c] if counts[c] > 0 else 0.0
+        if past_points.shape[0] < 2:
+            return
+        for i in range(past_points.shape[0]):
+            px = past_points[i, 0]
+            py = past_points[i, 1]
+            tested = False  # the free-space test only for a point inside some box
+            for c in range(n):
+                if lo[c, 0] <= px <= hi[c, 0] and lo[c, 1] <= py <= hi[c, 1]:
+                    if not tested:
+                        vacated = free_at(px, py, x, y, heading, ranges, angle_min,
+                                          angle_increment, margin)
+                        tested = True
+                    near[c] += 1
+                    if vacated:
+                        gone[c] += 1
+        for c in range(n):
+            if near[c] >= 2:
+                share = <double>gone[c] / <double>near[c]
+                if share > scores[c]:
+                    scores[c] = share
+    finally:
+        free(entered)
 
 
 def run_bounds(const double[::1] px, const double[::1] py, const double[::1] threshold,

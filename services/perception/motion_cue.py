@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.services.perception import _loops
-from zenav.services.perception.clustering import to_global
+from zenav.services.perception.clustering import Window, scan_window, to_global
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -165,30 +165,30 @@ class MotionCue:
         self.window_radius = window_radius
         self._scans: list[tuple[ScanSnapshot, IntArray, FloatArray]] = []
 
-    def _window(self, scan: ScanSnapshot, range_min: float) -> IntArray:
-        r = scan.ranges
-        return np.flatnonzero((r >= range_min) & (r < scan.range_max)
-                              & (r <= self.window_radius)).astype(np.int64)
-
     def score(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray) -> FloatArray:
         """Scores for this scan's clusters (max over the baselines), then remember it."""
         each, _ = self.score_each(scan, range_min, cluster_beams)
         best: FloatArray = each.max(axis=1, initial=0.0)
         return best
 
-    def score_each(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray
-                   ) -> tuple[FloatArray, FloatArray]:
+    def score_each(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray,
+                   window: Window | None = None) -> tuple[FloatArray, FloatArray]:
         """(n, k) scores of this scan's clusters against each baseline's earlier scan, and
         (k,) the stamps of those scans (nan where none is remembered yet); then remember
         this scan. A consumer that knows when an obstacle was first seen can ignore the
         comparisons with scans taken before: an obstacle that appeared out of nothing
-        occupies space those scans saw empty without having moved."""
-        window = self._window(scan, range_min)
-        points = scan.points(window)  # once per scan, kept for the scans after it
+        occupies space those scans saw empty without having moved. ``window``: the scan's
+        window (:func:`scan_window` with this cue's ``window_radius``) when the caller
+        has it already, as perception does from clustering."""
+        if window is None:
+            window = scan_window(scan.ranges, scan.angle_min, scan.angle_increment, range_min,
+                                 scan.range_max, scan.pose, self.window_radius)
+        # The window's global points, once per scan, kept for the scans after it.
+        beams, points = window.beams, np.column_stack((window.x, window.y))
         scores = np.zeros((len(cluster_beams), len(self.baselines)))
         stamps = np.full(len(self.baselines), np.nan)
         # The clusters' points and boxes once, for every baseline.
-        clustered = cluster_points(scan, cluster_beams, window, self.reach, points)
+        clustered = cluster_points(scan, cluster_beams, beams, self.reach, points)
         for j, baseline in enumerate(self.baselines):
             past = self._at_least(scan.stamp - baseline)
             if past is not None:
@@ -196,7 +196,7 @@ class MotionCue:
                 if clustered is not None:
                     scores[:, j] = scores_against(clustered, scan, past[0], past[2],
                                                   self.margin)
-        self._scans.append((scan, window, points))
+        self._scans.append((scan, beams, points))
         oldest = scan.stamp - self.baselines[-1] - 1.0
         while len(self._scans) > 1 and self._scans[1][0].stamp <= oldest:
             self._scans.pop(0)

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from zenav.schemas.messages import LaserScan
-from zenav.services.perception.clustering import Clusters, Pose, cluster_scan
+from zenav.services.perception.clustering import Clusters, Pose, cluster_window, scan_window
 from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot
 from zenav.services.perception.params import PerceptionParams
 
@@ -21,10 +19,11 @@ class Perceiver:
                              params.window_radius)
 
     def process(self, scan: LaserScan, pose: Pose) -> Clusters:
-        clusters = cluster_scan(scan.ranges, scan.angle_min, scan.angle_increment,
-                                scan.range_min, scan.range_max, pose, self.params)
+        # The window's returns and their global points once, for clustering and the cue.
+        window = scan_window(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min,
+                             scan.range_max, pose, self.params.window_radius)
+        clusters = cluster_window(window, scan.angle_increment, pose, self.params)
         snapshot = ScanSnapshot(scan.stamp, pose, scan.ranges.astype(np.float64),
                                 scan.angle_min, scan.angle_increment, scan.range_max)
-        each, stamps = self.cue.score_each(snapshot, scan.range_min, clusters.beams)
-        return dataclasses.replace(clusters, moved=each.max(axis=1, initial=0.0),
-                                   moved_each=each, moved_refs=stamps)
+        each, stamps = self.cue.score_each(snapshot, scan.range_min, clusters.beams, window)
+        return clusters.with_motion(each, stamps)

@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -50,7 +51,6 @@ from zenav.services.perception.clustering import (
     EDGE_FREE,
     EDGE_OCCLUDED,
     Clusters,
-    box_area,
     to_global,
 )
 from zenav.services.tracking.correlation import (
@@ -78,9 +78,10 @@ _PIECE_BEAMS = 3
 _STAMP_SLACK = 1e-6
 
 
-@dataclass(frozen=True)
-class Track:
-    """One tracked obstacle as output by :meth:`Tracker.update`.
+class Track(NamedTuple):
+    """One tracked obstacle as output by :meth:`Tracker.update` (an immutable record; a
+    named tuple, which costs a fraction of a frozen dataclass to build, once per track and
+    scan).
 
     Attributes:
         id: persistent id, unique over the tracker's life (1, 2, ...).
@@ -242,6 +243,12 @@ def _union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[
     return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
 
 
+def _cells(box: tuple[int, int, int, int]) -> int:
+    """Eq. 6 for one box of Python ints: the cells in it, as ``box_area`` counts them
+    (without the cost of a numpy call for four numbers)."""
+    return (box[1] - box[0] + 1) * (box[3] - box[2] + 1)
+
+
 class Tracker:
     """Frame-to-frame obstacle tracker (see the module notes).
 
@@ -307,13 +314,18 @@ class Tracker:
         centres = np.array([meas[i].centre for i in order], dtype=np.float64).reshape(-1, 2)
         boxes = np.array([meas[i].box for i in order], dtype=np.int64).reshape(-1, 4)
         ref_stamp, ref_centres, ref_boxes = self._reference(stamp)
-        corr = correlate(
-            centres, boxes, ref_centres, ref_boxes,
-            cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
-        )  # fmt: skip
-        best = best_match(corr)
-        best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
-        best_delta, best_index = best.delta.tolist(), best.index.tolist()
+        best_xi: list[float] = []
+        best_varsigma: list[float] = []
+        best_delta: list[float] = []
+        best_index: list[int] = []
+        if order:  # (a frame without obstacles has nothing to compare)
+            corr = correlate(
+                centres, boxes, ref_centres, ref_boxes,
+                cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
+            )  # fmt: skip
+            best = best_match(corr)
+            best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
+            best_delta, best_index = best.delta.tolist(), best.index.tolist()
 
         for row, ti in enumerate(order):
             t = self._tracks[ti]
@@ -327,7 +339,9 @@ class Tracker:
                     self._correct(t, m)
             was_static = t.kind == "static"
             if clusters.moved is not None:
-                moved = max(_moved_since_born(rows, c, t.born) for c in members[ti])
+                cl = members[ti]
+                moved = (_moved_since_born(rows, cl[0], t.born) if len(cl) == 1
+                         else max(_moved_since_born(rows, c, t.born) for c in cl))
                 if moved >= p.moved_threshold:
                     t.last_moved = stamp
             if smoothed:
@@ -353,7 +367,7 @@ class Tracker:
                 # in front or by the window edge neither grows nor shrinks it.
                 if not m.partial:
                     t.box = _union(t.box, m.box)
-                    t.area = int(box_area(t.box))
+                    t.area = _cells(t.box)
                     t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
@@ -565,7 +579,7 @@ class Tracker:
             point=(cx, cy) if use_chord else centre,
             radius=radius,
             box=box,
-            area=int(box_area(np.array(box))),  # Eq. 6
+            area=_cells(box),  # Eq. 6
             partial=bool(
                 clusters.edge_start[first] != EDGE_FREE or clusters.edge_end[last] != EDGE_FREE
             ),

@@ -174,3 +174,15 @@ def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
     assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes"]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_with_motion_is_the_chain_with_the_scores_replaced(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    ranges = random_ranges(rng, 361)
+    c = cluster_scan(ranges, -math.pi / 2, HALF_DEG, 0.05, 8.0, (1.0, 2.0, 0.3), PARAMS[0])
+    each = rng.uniform(0.0, 1.0, (len(c), 3))
+    refs = np.array([np.nan, 0.2, 0.4])
+    same(c.with_motion(each, refs),
+         dataclasses.replace(c, moved=each.max(axis=1, initial=0.0), moved_each=each,
+                             moved_refs=refs))

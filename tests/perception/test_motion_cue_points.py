@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from zenav.services.perception.motion_cue import ScanSnapshot, motion_scores
+from zenav.services.perception.clustering import scan_window
+from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot, motion_scores
 
 BEAMS = 181
 ANGLE_MIN, STEP = -np.pi / 2, np.pi / 180
@@ -88,3 +89,22 @@ def test_each_baseline_scores_as_motion_scores_does_alone(seed: int) -> None:
         past = next(x for x in scans if abs(x.stamp - stamp) < 1e-12)
         alone = motion_scores(now, clusters_of(now), window(now), past, window(past), 0.1, 0.5)
         assert np.array_equal(each[:, j], alone)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_window_from_clustering_gives_the_cues_own_scores(seed: int) -> None:
+    """Perception hands the cue the window clustering made (scan_window); the cue's
+    scores and the points it keeps are the ones it gets making the window itself."""
+    rng = np.random.default_rng(seed)
+    standing = [(float(rng.uniform(2, 4)), float(rng.uniform(-2, 2))) for _ in range(3)]
+    handed, own = MotionCue((0.1, 0.3), 0.1, 0.5, 6.0), MotionCue((0.1, 0.3), 0.1, 0.5, 6.0)
+    for i in range(5):
+        t = 0.1 * i
+        s = scan(t, (0.1 * t, 0.0, 0.01 * i), [*standing, (3.0, -1.0 + 0.6 * t)])
+        beams = clusters_of(s)
+        window = scan_window(s.ranges, ANGLE_MIN, STEP, 0.05, 8.0, s.pose, 6.0)
+        got, got_refs = handed.score_each(s, 0.05, beams, window)
+        want, want_refs = own.score_each(s, 0.05, beams)
+        assert np.array_equal(got, want) and np.array_equal(got_refs, want_refs, equal_nan=True)
+    for (_, b1, p1), (_, b2, p2) in zip(handed._scans, own._scans, strict=True):
+        assert np.array_equal(b1, b2) and np.array_equal(p1, p2)

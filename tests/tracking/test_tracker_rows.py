@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from zenav.services.perception.clustering import Clusters
-from zenav.services.tracking.tracker import _moved_since_born, _Rows
+from zenav.services.perception.clustering import Clusters, box_area
+from zenav.services.tracking.tracker import _cells, _moved_since_born, _Rows
 
 
 def chain(each: np.ndarray, refs: np.ndarray) -> Clusters:
@@ -53,3 +53,13 @@ def test_without_the_per_scan_scores_the_chains_own_score_counts() -> None:
     bare = dataclasses.replace(clusters, moved_each=None, moved_refs=None)
     rows = _Rows.of(bare)
     assert [_moved_since_born(rows, c, 5.0) for c in range(2)] == [0.7, 0.1]
+
+
+def test_one_boxs_cells_are_eq6_as_box_area_counts_them() -> None:
+    rng = np.random.default_rng(3)
+    lo = rng.integers(-50, 50, (200, 2))
+    size = rng.integers(0, 20, (200, 2))
+    boxes = np.column_stack([lo[:, 0], lo[:, 0] + size[:, 0], lo[:, 1], lo[:, 1] + size[:, 1]])
+    want = box_area(boxes).tolist()
+    assert [_cells((a, b, c, d)) for a, b, c, d in boxes.tolist()] == want
+    assert _cells((2, 4, 1, 1)) == 3  # x 2..4 by y 1..1

@@ -101,10 +101,13 @@ def test_eq1_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def test_eq1_is_what_the_motion_cue_calls(monkeypatch: pytest.MonkeyPatch) -> None:
     """The free-space motion test puts each scan's points in the global frame by Eq. 1
-    too (perception's node runs it on every scan, after the clustering)."""
-    spy = Spy(monkeypatch, motion_cue, "to_global")
+    too: perception hands it the window's points the clustering made global
+    (``scan_window``), one Eq. 1 pass for both."""
+    spy = Spy(monkeypatch, clustering, "to_global")
+    own = Spy(monkeypatch, motion_cue, "to_global")
     perceive([2.0, 2.0, 2.0])
-    assert spy.calls == 1  # the window's points, once per scan
+    assert spy.calls == 2  # the window's points for both, then the Eq. 5 centres
+    assert own.calls == 0
 
 
 def test_the_motion_cue_points_are_eq1() -> None:
