@@ -78,3 +78,36 @@ def test_the_eight_settings():
 def test_bad_arguments_are_one_line(args, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
         check(*args)
+
+
+@pytest.mark.parametrize("reuse", [False, True])
+def test_a_sweep_makes_every_run_again_unless_told_to_reuse(tmp_path, monkeypatch, reuse):
+    """A run.json left in --out by an earlier sweep (older code, say) is that run's record
+    only with ``reuse``; otherwise the run is made again and its record replaces it."""
+    import json
+
+    from zenav import batch
+    from zenav.bench.crowd import run_crowd
+
+    made: list[str] = []
+
+    def fake_run(scenario, out, **options):
+        made.append(out.name)
+        fresh = record(options["planner"], "reached", 10.0, [1.0])
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "run.json").write_text(json.dumps(fresh))
+        return fresh
+
+    monkeypatch.setattr(batch, "run_scenario", fake_run)
+    kept = tmp_path / "runs" / "circle-invisible-360" / "paper" / "0"
+    kept.mkdir(parents=True)
+    (kept / "run.json").write_text(json.dumps(record("paper", "collision", 3.0, [1.0])))
+
+    report = run_crowd(["paper"], tmp_path, cases=2, settings=["circle-invisible-360"],
+                       jobs=1, engine="stack", progress=False, reuse=reuse,
+                       echo=lambda text: None)
+
+    assert sorted(made) == (["1"] if reuse else ["0", "1"])
+    rows = json.loads((tmp_path / "crowd.json").read_text())["settings"]
+    assert rows["circle-invisible-360"][0]["collision"] == (0.5 if reuse else 0.0)
+    assert ("--reuse" in report) == reuse

@@ -4,8 +4,11 @@ the goal line names every family short of the target."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
+
+import pytest
 
 from zenav.bench.nav import goal_lines, still_at_end, summarise, write_worlds
 from zenav.sim.scenario import load_scenario
@@ -66,3 +69,36 @@ def test_the_goal_is_met_when_every_family_reaches_the_target() -> None:
     (paper,), families = summarise(records, ["paper"])
     assert paper.stuck == []
     assert goal_lines([paper], families).endswith("stood still: 0 (met).")
+
+
+@pytest.mark.parametrize("reuse", [False, True])
+def test_a_sweep_makes_every_run_again_unless_told_to_reuse(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, reuse: bool) -> None:
+    """A run.json left in --out by an earlier sweep is that run's record only with
+    ``reuse``; otherwise the run is made again and its record replaces it."""
+    from zenav import batch
+    from zenav.bench.nav import run_nav
+
+    made: list[str] = []
+
+    def fake_run(scenario: Path, out: Path, **options: Any) -> dict[str, Any]:
+        made.append(scenario.stem)
+        fresh = record(scenario.stem, "reached", standing_from(60.0, 60.0))
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "run.json").write_text(json.dumps(fresh))
+        return fresh
+
+    monkeypatch.setattr(batch, "run_scenario", fake_run)
+    kept = tmp_path / "runs" / "paper" / "static-0"
+    kept.mkdir(parents=True)
+    (kept / "run.json").write_text(json.dumps(record("static-0", "collision", [])))
+
+    report = run_nav(["paper"], 2, 0, tmp_path, families=["static"], jobs=1, engine="stack",
+                     progress=False, echo=lambda text: None, reuse=reuse)
+
+    assert sorted(made) == (["static-1"] if reuse else ["static-0", "static-1"])
+    outcomes = {r["scenario"]: r["outcome"]
+                for r in json.loads((tmp_path / "nav.json").read_text())}
+    assert outcomes == {"static-0": "collision" if reuse else "reached",
+                        "static-1": "reached"}
+    assert ("--reuse" in report) == reuse

@@ -45,9 +45,10 @@ __all__ = ["ENGINES", "SETTINGS", "Setting", "discomfort_steps", "run_crowd", "s
 
 Record = dict[str, Any]
 OnDone = Callable[[Job, Record], None]
-Engine = Callable[[Sequence[Job], int, OnDone], dict[str, Record]]
-"""(jobs, runs at a time, called as each run ends) -> the records by job key. A run that
-fails gives a record with outcome ``error``; a kept ``run.json`` is reused."""
+Engine = Callable[[Sequence[Job], int, OnDone, bool], dict[str, Record]]
+"""(jobs, runs at a time, called as each run ends, reuse) -> the records by job key. A run
+that fails gives a record with outcome ``error``; with ``reuse``, a ``run.json`` already in
+a run's directory is its record."""
 
 
 @dataclass(frozen=True)
@@ -74,17 +75,19 @@ SETTINGS: dict[str, Setting] = {
 PLANNERS = ("paper", "vfh", "dwa", "apf", "orca")
 
 
-def stack_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone) -> dict[str, Record]:
+def stack_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone,
+                 reuse: bool = False) -> dict[str, Record]:
     """Every job through ``zenav run``'s path (the whole service stack, lockstep)."""
-    return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=True,
+    return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=reuse,
                      keep_going=True)
 
 
-def inprocess_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone) -> dict[str, Record]:
+def inprocess_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone,
+                     reuse: bool = False) -> dict[str, Record]:
     """Every job with the in-process engine (``zenav run --engine inprocess``) in worker
     processes; a seeded sample is then re-made through the stack and compared tick by
     tick (:func:`zenav.batch.run_batch`)."""
-    return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=True,
+    return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=reuse,
                      keep_going=True, engine="inprocess", picture=False)
 
 
@@ -227,9 +230,11 @@ def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: 
 
 def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int = 0,
               settings: Sequence[str] = tuple(SETTINGS), jobs: int = 2, engine: str = "inprocess",
-              progress: bool = True,
+              progress: bool = True, reuse: bool = False,
               echo: Callable[[str], None] = print) -> str:
-    """Write the cases, run them, print and write ``crowd.md``, ``crowd.png``, ``crowd.json``."""
+    """Write the cases, run them, print and write ``crowd.md``, ``crowd.png``, ``crowd.json``.
+    ``reuse``: a run whose ``run.json`` is already under ``out`` is not run again (its
+    wall time is then not the sweep's)."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -261,7 +266,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
             finished = sum(len(v) for v in records.values())
             bar.update(task, advance=1, description=f"{finished} done, {reached} reached")
 
-        ENGINES[engine](job_list, jobs, done)
+        ENGINES[engine](job_list, jobs, done, reuse)
     wall = time.monotonic() - started
     for name in settings:
         for r in records[name]:
@@ -271,7 +276,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
     command = (f"zenav bench crowd --cases {cases} --planners {','.join(planners)} "
                f"--seed {seed} --jobs {jobs} --engine {engine}"
                + ("" if tuple(settings) == tuple(SETTINGS) else
-                  f" --settings {','.join(settings)}"))
+                  f" --settings {','.join(settings)}") + (" --reuse" if reuse else ""))
     parts = [f"# zenav bench crowd\n\n`{command}`\n\n"
              f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
              f"{len(job_list)} runs ({cases} cases x {len(planners)} planners x "
@@ -301,7 +306,7 @@ def _command(args: argparse.Namespace) -> int:
     try:
         run_crowd(words(args.planners), args.out, cases=args.cases, seed=args.seed,
                   settings=words(args.settings), jobs=args.jobs, engine=args.engine,
-                  progress=not args.no_progress)
+                  progress=not args.no_progress, reuse=args.reuse)
     except ValueError as exc:
         print(f"zenav bench crowd: {exc}", file=sys.stderr)
         return 2
@@ -331,5 +336,8 @@ def add_command(kinds: Any) -> None:
                        "zenav run's six processes)")
     crowd.add_argument("--out", type=Path, default=Path("out/bench-crowd"),
                        help="directory for the cases, runs, crowd.md, crowd.png, crowd.json")
+    crowd.add_argument("--reuse", action="store_true",
+                       help="take a run.json already under --out as that run's record "
+                       "(finish an interrupted sweep; by default every run is made again)")
     crowd.add_argument("--no-progress", action="store_true", help="no progress bar")
     crowd.set_defaults(func=_command)

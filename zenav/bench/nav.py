@@ -253,8 +253,9 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             families: Sequence[str] = FAMILIES, jobs: int = 2,
             progress: bool = True, echo: Callable[[str], None] = print,
             engine: str = "inprocess", verify: int = DEFAULT_VERIFY,
-            fov_deg: float | None = None) -> str:
-    """Write the worlds, run every planner on each, print and write the report."""
+            fov_deg: float | None = None, reuse: bool = False) -> str:
+    """Write the worlds, run every planner on each, print and write the report.
+    ``reuse``: a run whose ``run.json`` is already under ``out`` is not run again."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -299,7 +300,7 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             bar.update(task, advance=1, description=f"{reached}/{len(records)} reached; "
                        f"{job.planner} {job.name}: {record['outcome']}")
 
-        batch = run_batch(job_list, jobs, done, log_level="WARNING", reuse=True,
+        batch = run_batch(job_list, jobs, done, log_level="WARNING", reuse=reuse,
                           keep_going=True, engine=engine, verify=verify,
                           picture=engine == "stack", echo=echo)
     for r in records:
@@ -314,7 +315,8 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
                                    f" --families {','.join(families)}")
-               + ("" if fov_deg is None else f" --fov {fov_deg:g}"))
+               + ("" if fov_deg is None else f" --fov {fov_deg:g}")
+               + (" --reuse" if reuse else ""))
     report = (f"# zenav bench nav\n\n`{command}`\n\n"
               f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
               f"{len(paths)} worlds ({worlds} per family: {', '.join(families)}"
@@ -336,7 +338,7 @@ def _command(args: argparse.Namespace) -> int:
         run_nav(words(args.planners), args.worlds, args.seed, args.out,
                 families=words(args.families), jobs=args.jobs,
                 progress=not args.no_progress, engine=args.engine, verify=args.verify,
-                fov_deg=args.fov)
+                fov_deg=args.fov, reuse=args.reuse)
     except ValueError as exc:
         print(f"zenav bench nav: {exc}", file=sys.stderr)
         return 2
@@ -367,5 +369,8 @@ def add_command(kinds: Any) -> None:
                      help="every world's laser field of view, degrees (default: each "
                      "world's own, the paper's 180; 360 shows what the 180° laser "
                      "cannot see)")
+    nav.add_argument("--reuse", action="store_true",
+                     help="take a run.json already under --out as that run's record "
+                     "(finish an interrupted sweep; by default every run is made again)")
     nav.add_argument("--no-progress", action="store_true", help="no progress bar")
     nav.set_defaults(func=_command)
