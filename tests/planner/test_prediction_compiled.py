@@ -64,8 +64,8 @@ def test_box_gaps_is_the_numpy_arithmetic(seed: int) -> None:
     (start, direction, length), _ = random_line(seed)
     first = np.empty(len(cells), dtype=np.int64)
     least = np.empty(len(cells), dtype=np.float64)
-    box_gaps(*start.tolist(), *direction.tolist(), length, len(points), cells, cell,
-             clearances, first, least)
+    (sx, sy), (dx, dy) = start.tolist(), direction.tolist()
+    box_gaps(sx, sy, dx, dy, length, len(points), cells, cell, clearances, first, least)
     want_first, want_least = numpy_box_gaps(points, cells, cell, clearances)
     assert first.tolist() == want_first
     assert least.tobytes() == np.array(want_least, dtype=np.float64).tobytes()
