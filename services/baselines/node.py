@@ -5,8 +5,12 @@ parameters: ``params.py``.
 
 It answers each track list with one velocity command stamped with the tracks' stamp
 (lockstep depends on it) and answers a repeated stamp by repeating its command. The
-scan that goes with a track list (same stamp; it arrives first, straight from the laser
-driver) and the odometry of that instant are kept by stamp. Tracks give the robot pose
+scan that goes with a track list (same stamp; it usually arrives first, straight from
+the laser driver) and the odometry of that instant are kept by stamp. As in the paper
+planner's service, a decision waits for both halves of a stamp, whichever comes first,
+so that a loaded machine does not change the result: a track list whose scan has not
+come within ``scan_wait`` wall seconds (or is overtaken by a newer track list) is
+decided on the newest scan before it. Tracks give the robot pose
 at scan time and the movers. The planner state says ``a`` (no paper scenario) and the
 action: ``keep`` when moving, ``stop`` when standing, ``goal`` at the goal; an event is
 published when the action changes.
@@ -14,6 +18,7 @@ published when the action changes.
 
 from __future__ import annotations
 
+import asyncio
 from typing import Protocol
 
 import numpy as np
@@ -93,6 +98,8 @@ class BaselineService:
         self.odometry: dict[float, Odometry] = {}
         self.last_action: Action | None = None
         self.last_command = (0.0, 0.0)
+        self.pending: TrackList | None = None  # a track list waiting for its scan
+        self.timer: asyncio.TimerHandle | None = None
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=4)
         node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=8)
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
@@ -101,6 +108,8 @@ class BaselineService:
         self.scans[scan.stamp] = scan
         while len(self.scans) > KEPT:
             del self.scans[min(self.scans)]
+        if self.pending is not None and self.pending.stamp == scan.stamp:
+            self.decide(self.pending)
 
     def on_odometry(self, odometry: Odometry) -> None:
         self.odometry[odometry.stamp] = odometry
@@ -123,6 +132,25 @@ class BaselineService:
     def on_tracks(self, tracks: TrackList) -> None:
         if not self.gate.admit(tracks.stamp, self.commands):
             return
+        if self.pending is not None:  # overtaken before its scan came: decide it now
+            self.decide(self.pending)
+        if tracks.stamp in self.scans:
+            self.decide(tracks)
+            return
+        self.pending = tracks
+        self.timer = asyncio.get_running_loop().call_later(
+            self.params.scan_wait, self._scan_late, tracks.stamp)
+
+    def _scan_late(self, stamp: float) -> None:
+        if self.pending is not None and self.pending.stamp == stamp:
+            self.decide(self.pending)
+
+    def decide(self, tracks: TrackList) -> None:
+        """The command for ``tracks``, on the scan of its stamp or else the newest before."""
+        self.pending = None
+        if self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
         at = latest_at(self.scans, tracks.stamp)
         v = omega = 0.0
         action: Action = "stop"

@@ -23,6 +23,13 @@ class MissionParams(BaseModel):
         None, description="start of the global path, m; default: the first pose seen"
     )
     goal_tolerance: float = Field(0.25, gt=0, description="arrived within this distance, m")
+    scan_wait: float = Field(
+        1.0, gt=0, description="wall s the planner waits for the scan of a track list's "
+        "stamp before deciding without it (the paper planner: without a map update; a "
+        "baseline: on the newest scan before); in real time the next track list (0.1 s "
+        "later at 10 Hz) ends the wait sooner, so this bound matters in lockstep runs, "
+        "where it keeps a loaded machine from changing the result"
+    )
 
     # --- the robot ------------------------------------------------------------------
     cruise_speed: float = Field(0.1, gt=0, description="V_R, m/s")
@@ -215,12 +222,6 @@ class Params(MissionParams, StopZoneParams):
         1.0, gt=0, description="s between two sends of an unchanged global path (or of "
         "none, when no way is known): a new path is sent at once, and sent again at this "
         "period so that a viewer or recorder that joins late has it within this time"
-    )
-    scan_wait: float = Field(
-        1.0, gt=0, description="wall s the planner waits for the scan of a track list's "
-        "stamp before deciding without a map update; in real time the next track list "
-        "(0.1 s later at 10 Hz) ends the wait sooner, so this bound matters in lockstep "
-        "runs, where it keeps a loaded machine from changing the result"
     )
 
     # --- the global path (global_path.py) ---------------------------------------------

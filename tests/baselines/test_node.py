@@ -94,3 +94,31 @@ async def test_no_scan_yet_means_stop_and_the_goal_means_stop(name):
     assert [(c.v, c.omega) for c in commands] == [(0.0, 0.0), (0.0, 0.0)]
     assert [e.action for e in events] == ["stop", "goal"]
     assert all(e.scenario == "a" for e in events)
+
+
+async def _command_at_0_1(name: str, tracks_first: bool) -> VelocityCommand:
+    """The command for t = 0.1 when the scan of that stamp shows a wall 0.4 m ahead (the
+    one before showed open road), the track list coming before or after that scan."""
+    async with planner(name, cruise_speed=0.2) as h:
+        h.send(keys.SCAN, scan(0.0))
+        h.send(keys.ODOM, Odometry(stamp=0.0, seq=0, pose=POSE, v=0.2, omega=0.0))
+        await h.settle()
+        h.send(keys.TRACKS, tracks(0.0))
+        await h.settle()
+        h.send(keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.2, omega=0.0))
+        halves = [(keys.TRACKS, tracks(0.1)), (keys.SCAN, scan(0.1, ranges=0.4))]
+        for key, message in halves if tracks_first else reversed(halves):
+            h.send(key, message)
+            await h.settle()
+        commands = h.received(keys.CMD_VEL, VelocityCommand)
+    assert [c.stamp for c in commands] == [0.0, 0.1]
+    return commands[1]
+
+
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf", "orca"])
+async def test_a_track_list_waits_for_the_scan_of_its_stamp(name):
+    """Under load a track list can come before its own scan: the decision waits for it,
+    so the command does not depend on the arrival order (lockstep runs stay the same)."""
+    early = await _command_at_0_1(name, tracks_first=True)
+    late = await _command_at_0_1(name, tracks_first=False)
+    assert (early.v, early.omega) == (late.v, late.omega)
