@@ -61,6 +61,7 @@ def return_bounds(double x, double y, const double[::1] ux, const double[::1] uy
     return x_lo, y_lo, x_hi, y_hi
 
 
+@cython.cdivision(True)
 def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
                const double[::1] ranges, double range_min, double range_max,
                const double[:, ::1] movers, double ox, double oy, double resolution,
@@ -83,13 +84,17 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
        starting now, ``hit_since``, unless it was occupied already), and a wall once
        that spell has lasted ``confirm`` seconds.
 
-    A cell is found with the arithmetic of ``Costmap.cell_of`` (``cell_index``).
+    A cell is found with the arithmetic of ``Costmap.cell_of`` (``cell_index``; along
+    the beams, the same floors of the same quotients, read off them as the comments
+    there say, and no point after a beam has left the grid: it never comes back).
     """
     cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t nx = seen.shape[0] // ny
-    cdef Py_ssize_t b, k, m, ix, iy, cell, count = 0
+    cdef Py_ssize_t b, m, ix, iy, cell, count = 0
     cdef double step = resolution / 2
-    cdef double rho, reach, px, py, s, bx, by
+    cdef double rho, reach, px, py, s, bx, by, kd, qx, qy
+    cdef double width = <double>nx, height = <double>ny
+    cdef bint entered
     cdef bint clear_of_movers
     marks = np.empty(n, dtype=np.intp)
     cdef Py_ssize_t[::1] marked = marks
@@ -120,19 +125,31 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
         if reach > range_max:  # (a nan stays nan: no point along that beam)
             reach = range_max
         bx, by = ux[b], uy[b]
-        k = 0
-        while k * step <= reach:
-            s = k * step
-            k += 1
-            ix = cell_index(bx * s + x - ox, resolution)
-            iy = cell_index(by * s + y - oy, resolution)
-            # (0 <= ix < nx and 0 <= iy < ny, as one test)
-            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
-                cell = ix * ny + iy
+        # The point's cell is (floor(qx), floor(qy)), in the grid when 0 <= qx < nx and
+        # 0 <= qy < ny (as ``cell_index`` and the bounds test have it: the floor of a
+        # quotient is in [0, n) exactly when the quotient is in [0, n), and a nan is in
+        # neither); the truncations are then the floors. Along a beam qx and qy never go
+        # back (every step is a rounded operation that keeps the order of its operand:
+        # k step, times the beam's fixed direction, plus and minus fixed offsets, divided
+        # by the resolution), so the points in the grid are one unbroken run: the first
+        # point out after one in ends the beam.
+        kd = 0.0  # k as a double (whole numbers: k * step as before)
+        s = 0.0
+        entered = False
+        while s <= reach:
+            qx = (bx * s + x - ox) / resolution
+            qy = (by * s + y - oy) / resolution
+            kd += 1.0
+            s = kd * step
+            if (qx >= 0.0) & (qx < width) & (qy >= 0.0) & (qy < height):
+                entered = True
+                cell = <Py_ssize_t>qx * ny + <Py_ssize_t>qy
                 if not returned[cell]:
                     seen[cell] = stamp
                     occupied[cell] = 0
                     walls[cell] = 0
+            elif entered:
+                break
     for m in range(count):
         returned[marked[m]] = 0
     for m in range(count):

@@ -114,6 +114,28 @@ def test_the_compiled_update_gives_the_grids_of_the_numpy_one(seed: int,
     assert unconfirmed and compiled.walls.any()  # marks before and after confirmation
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_beams_that_leave_the_grid_or_start_outside_it_trace_alike(seed: int) -> None:
+    """A grid held small by ``max_size``: most beams run out of it (the compiled loop
+    ends a beam at its first point out after one in), and the robot itself is at times
+    outside it (no point of a beam in, or the beam entering it from outside)."""
+    rng = np.random.default_rng(100 + seed)
+    compiled = Costmap((4.0, 4.0), (5.0, 5.0), resolution=0.1, decay=60.0, inflation=0.3,
+                       confirm=0.0, padding=0.5, max_size=2.5)
+    reference = copy.deepcopy(compiled)
+    outside = 0
+    for k in range(12):
+        pose = (float(rng.uniform(1.0, 8.0)), float(rng.uniform(1.0, 8.0)),
+                float(rng.uniform(-3.0, 3.0)))
+        ranges = np.minimum(rng.uniform(0.2, 9.0, 181), 8.0)
+        scan = ScanData(pose, ranges, -math.pi / 2, math.pi / 180, 8.0)
+        compiled.update(scan, 0.1 * k)
+        numpy_update(reference, scan, 0.1 * k)
+        assert same_grids(compiled, reference)
+        outside += not compiled.inside(compiled.cell_of(np.array([pose[:2]])))[0]
+    assert outside  # the robot was beyond the grid at least once
+
+
 def test_a_scan_with_no_return_and_one_with_nan_ranges_trace_alike() -> None:
     compiled = Costmap((0.0, 0.0), (3.0, 0.0), resolution=0.1, decay=60.0, inflation=0.3,
                        confirm=0.0, padding=1.0, max_size=30.0)
