@@ -211,6 +211,56 @@ def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
                 out[a * ny + b] = 1
 
 
+def closed_off(const unsigned char[::1] walls, Py_ssize_t nx, Py_ssize_t ny,
+               const long[::1] di, const long[::1] dj, Py_ssize_t si, Py_ssize_t sj,
+               Py_ssize_t gi, Py_ssize_t gj, Py_ssize_t reach):
+    """Whether no way of free cells joins the start's window to the goal's, in the flat
+    grid ``walls`` (``nx`` by ``ny``, ``ny`` cells a column): a cell is free when no
+    wall cell lies at an offset ``(di[k], dj[k])`` from it (``stamp_discs`` round the
+    walls), a way is a run of free cells each beside the last (4 neighbours, as
+    ``scipy.ndimage.label``'s default joins them), and a cell's window is the cells at
+    most ``reach`` from it along each axis (within the grid). A flood from the free
+    cells of the start's window, stopping at the first cell of the goal's."""
+    cdef Py_ssize_t size = nx * ny, c, i, j, k, head = 0, tail = 0, a, b, n
+    state_array = np.zeros(size, dtype=np.uint8)  # 0 free, 1 blocked, 2 reached
+    queue_array = np.empty(size, dtype=np.intp)
+    cdef unsigned char[::1] state = state_array
+    cdef Py_ssize_t[::1] queue = queue_array
+    for c in range(size):
+        if walls[c]:
+            i = c // ny
+            j = c % ny
+            for k in range(di.shape[0]):
+                a = i + di[k]
+                b = j + dj[k]
+                if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
+                    state[a * ny + b] = 1
+    for i in range(max(si - reach, 0), min(si + reach + 1, nx)):
+        for j in range(max(sj - reach, 0), min(sj + reach + 1, ny)):
+            c = i * ny + j
+            if state[c] == 0:
+                state[c] = 2
+                queue[tail] = c
+                tail += 1
+    while head < tail:
+        c = queue[head]
+        head += 1
+        i = c // ny
+        j = c % ny
+        if gi - reach <= i <= gi + reach and gj - reach <= j <= gj + reach:
+            return False
+        for k in range(4):
+            a = i + (k == 0) - (k == 1)
+            b = j + (k == 2) - (k == 3)
+            if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
+                n = a * ny + b
+                if state[n] == 0:
+                    state[n] = 2
+                    queue[tail] = n
+                    tail += 1
+    return True
+
+
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,
           double y0, double theta0, double v0, double gain, double max_omega,
           double accel, double decel, double[:, ::1] xs, double[:, ::1] ys):

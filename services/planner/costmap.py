@@ -41,10 +41,11 @@ from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
-from scipy.ndimage import distance_transform_edt, label
+from scipy.ndimage import distance_transform_edt
 
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
+    closed_off,
     line_any,
     look_up,
     look_up_rows,
@@ -131,6 +132,7 @@ class Costmap:
         self._inflated: tuple[BoolGrid, BoolGrid] | None = None
         self._gap: npt.NDArray[np.float64] | None = None  # of _inflated's lethal cells
         self._disc = _disc_offsets(resolution, inflation)
+        self._clearance_discs: dict[float, tuple[npt.NDArray[np.int_], npt.NDArray[np.int_]]] = {}
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
 
     # -- geometry ----------------------------------------------------------------------
@@ -269,16 +271,18 @@ class Costmap:
             return False  # beyond the grid: no knowledge, no verdict
         if not self.walls.any():
             return False
-        free = self._distances(self.walls) > clearance
-        labels, _ = label(free)
+        # The free cells are those farther than ``clearance`` from every wall cell (by
+        # the distance transform's test: the cells outside the walls' discs of
+        # ``_disc_offsets``), the ways 4-connected (``scipy.ndimage.label``'s): a flood
+        # in compiled code (``_loops.closed_off``) from the free cells near the start.
+        if clearance not in self._clearance_discs:
+            self._clearance_discs[clearance] = _disc_offsets(self.resolution, clearance)
+        di, dj = self._clearance_discs[clearance]
         reach = math.ceil(clearance / self.resolution) + 1
-
-        def near(cell: npt.NDArray[np.int64]) -> set[int]:
-            i, j = int(cell[0]), int(cell[1])
-            window = labels[max(i - reach, 0):i + reach + 1, max(j - reach, 0):j + reach + 1]
-            return set(np.unique(window[window > 0]).tolist())
-
-        return not near(ends[0]) & near(ends[1])
+        nx, ny = self.shape
+        (si, sj), (gi, gj) = ends.tolist()
+        return closed_off(_flat(self.walls).view(np.uint8), nx, ny, di, dj, si, sj, gi, gj,
+                          reach)
 
     def _distances(self, cells: BoolGrid) -> npt.NDArray[np.float64]:
         """(nx, ny) distance from each cell's centre to the nearest of ``cells`` (at least
