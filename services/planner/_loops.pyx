@@ -196,6 +196,22 @@ def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, do
                 break
 
 
+def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
+                 const double[::1] hit_since, double known_from, double confirmed_by,
+                 const unsigned char[::1] before, unsigned char[::1] out):
+    """Into ``out`` (one byte a cell of the flat grids) the lethal cells of
+    ``Costmap.lethal``: occupied, seen at ``known_from`` or later, and occupied since
+    ``confirmed_by`` or earlier (the same comparisons: a nan is neither); whether they
+    differ from ``before`` (a grid of the same size, the last lethal cells)."""
+    cdef Py_ssize_t c
+    cdef unsigned char flag, changed = 0
+    for c in range(occupied.shape[0]):
+        flag = (occupied[c] != 0) & (seen[c] >= known_from) & (hit_since[c] <= confirmed_by)
+        out[c] = flag
+        changed |= flag != before[c]
+    return changed != 0
+
+
 def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
                 const long[::1] di, const long[::1] dj, unsigned char[::1] out):
     """Flag in ``out`` (the flat grid, ``ny`` cells a column) every cell within the

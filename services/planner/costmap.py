@@ -46,6 +46,7 @@ from scipy.ndimage import distance_transform_edt
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
     closed_off,
+    lethal_cells,
     line_any,
     look_up,
     look_up_rows,
@@ -134,6 +135,9 @@ class Costmap:
         self._disc = _disc_offsets(resolution, inflation)
         self._clearance_discs: dict[float, tuple[npt.NDArray[np.int_], npt.NDArray[np.int_]]] = {}
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
+        # The beams' angles from the heading, and the (angle_min, angle_increment, count)
+        # they were made for.
+        self._beams: tuple[tuple[float, float, int], npt.NDArray[np.float64]] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -209,10 +213,14 @@ class Costmap:
         self.now = max(self.now, stamp)
         x, y, heading = scan.pose
         ranges = np.ascontiguousarray(scan.ranges, dtype=np.float64)
-        alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
+        beams = (scan.angle_min, scan.angle_increment, ranges.size)
+        if self._beams is None or self._beams[0] != beams:  # the same laser, scan after scan
+            self._beams = (beams, scan.angle_min + scan.angle_increment
+                           * np.arange(ranges.size))
+        alpha = self._beams[1]
         # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
         # robot); a return lies at the robot plus its range times that (Eq. 1 again).
-        ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
+        ux, uy = to_global((0.0, 0.0, heading), 1.0, alpha)
         ux, uy = np.ascontiguousarray(ux), np.ascontiguousarray(uy)
         box = return_bounds(x, y, ux, uy, ranges, scan.range_min, scan.range_max)
         self._grow_to_box(*box, self.padding / 2)
@@ -304,10 +312,19 @@ class Costmap:
         if self._inflated is not None and self._refreshed == (self.version, self.now):
             return self._inflated
         self._refreshed = (self.version, self.now)
-        lethal = self.lethal()
-        # The inflation depends on the lethal set alone: compare the set itself (every
-        # update bumps the version, though the set mostly stays the same).
-        if self._inflated is not None and np.array_equal(self._inflated[0], lethal):
+        # ``lethal()`` in one compiled pass (``_loops.lethal_cells``), which also says
+        # whether the set differs from the last: the inflation depends on the set alone
+        # (every update bumps the version, though the set mostly stays the same).
+        lethal = np.empty_like(self.occupied)
+        before = self._inflated[0] if self._inflated is not None else None
+        if before is not None and before.shape != lethal.shape:
+            before = None
+        changed = lethal_cells(
+            _flat(self.occupied).view(np.uint8), _flat(self.seen), _flat(self.hit_since),
+            self.now - self.decay, self.now - self.confirm,
+            _flat(lethal if before is None else before).view(np.uint8),
+            _flat(lethal).view(np.uint8))
+        if self._inflated is not None and before is not None and not changed:
             return self._inflated
         # The blocked cells are those within the inflation distance of a lethal one;
         # the distances themselves (``gap``) only when asked: most cycles need none.

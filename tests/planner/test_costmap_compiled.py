@@ -274,3 +274,39 @@ def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
     got = cm.blocked_rows(xs, ys)
     assert np.array_equal(got, want.any(axis=1))
     assert got.any() and not got.all()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_compiled_lethal_cells_are_lethals(seed: int) -> None:
+    """The lethal grid ``_refresh`` makes in one compiled pass (``_loops.lethal_cells``,
+    what ``lethal_grid`` and the inflation read) against ``lethal()``, the numpy test:
+    cells seen and hit at random times, on the decay and confirmation edges exactly,
+    never seen (-inf), nan; and the cache kept only while the set stays the same."""
+    rng = np.random.default_rng(seed)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=2.0, inflation=0.3,
+                 confirm=0.5, padding=1.0, max_size=30.0)
+    kept = renewed = 0
+    old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy())
+    for k in range(30):
+        cm.now = 10.0 + 0.1 * k
+        if rng.random() < 0.7:  # else the grids stay and only the time moves on
+            cm.occupied = rng.random(cm.shape) < 0.3
+            cm.seen = rng.choice([cm.now - 2.0, cm.now - 1.0, cm.now - 3.0, -math.inf,
+                                  math.nan, cm.now], size=cm.shape)
+            cm.hit_since = rng.choice([cm.now - 0.5, cm.now - 0.4, cm.now, math.inf,
+                                       math.nan, cm.now - 9.0], size=cm.shape)
+            if rng.random() < 0.3 and k:  # the same cells again, new arrays
+                cm.occupied, cm.seen, cm.hit_since = old
+            cm.version += 1
+        old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy())
+        before = cm._inflated
+        got = cm.lethal_grid()
+        with np.errstate(invalid="ignore"):
+            want = cm.lethal()
+        assert np.array_equal(got, want) and got.dtype == want.dtype
+        if before is not None and before[0] is got:
+            kept += 1
+            assert np.array_equal(before[0], want)
+        else:
+            renewed += 1
+    assert kept and renewed
