@@ -237,43 +237,40 @@ def closed_off(const unsigned char[::1] walls, Py_ssize_t nx, Py_ssize_t ny,
     ``scipy.ndimage.label``'s default joins them), and a cell's window is the cells at
     most ``reach`` from it along each axis (within the grid). A flood from the free
     cells of the start's window, stopping at the first cell of the goal's."""
-    cdef Py_ssize_t size = nx * ny, c, i, j, k, head = 0, tail = 0, a, b, n
+    cdef Py_ssize_t size = nx * ny, c, i, j, k, head = 0, tail = 0, a, b
     state_array = np.zeros(size, dtype=np.uint8)  # 0 free, 1 blocked, 2 reached
-    queue_array = np.empty(size, dtype=np.intp)
+    queue_array = np.empty((size, 2), dtype=np.int32)  # (i, j) of the cells reached
     cdef unsigned char[::1] state = state_array
-    cdef Py_ssize_t[::1] queue = queue_array
-    for c in range(size):
-        if walls[c]:
-            i = c // ny
-            j = c % ny
-            for k in range(di.shape[0]):
-                a = i + di[k]
-                b = j + dj[k]
-                if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
-                    state[a * ny + b] = 1
+    cdef int[:, ::1] queue = queue_array
+    for i in range(nx):
+        for j in range(ny):
+            if walls[i * ny + j]:
+                for k in range(di.shape[0]):
+                    a = i + di[k]
+                    b = j + dj[k]
+                    if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
+                        state[a * ny + b] = 1
     for i in range(max(si - reach, 0), min(si + reach + 1, nx)):
         for j in range(max(sj - reach, 0), min(sj + reach + 1, ny)):
-            c = i * ny + j
-            if state[c] == 0:
-                state[c] = 2
-                queue[tail] = c
+            if state[i * ny + j] == 0:
+                state[i * ny + j] = 2
+                queue[tail, 0] = <int>i
+                queue[tail, 1] = <int>j
                 tail += 1
     while head < tail:
-        c = queue[head]
+        i = queue[head, 0]
+        j = queue[head, 1]
         head += 1
-        i = c // ny
-        j = c % ny
         if gi - reach <= i <= gi + reach and gj - reach <= j <= gj + reach:
             return False
         for k in range(4):
             a = i + (k == 0) - (k == 1)
             b = j + (k == 2) - (k == 3)
-            if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
-                n = a * ny + b
-                if state[n] == 0:
-                    state[n] = 2
-                    queue[tail] = n
-                    tail += 1
+            if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny) and state[a * ny + b] == 0:
+                state[a * ny + b] = 2
+                queue[tail, 0] = <int>a
+                queue[tail, 1] = <int>b
+                tail += 1
     return True
 
 
