@@ -215,8 +215,8 @@ class Costmap:
         ranges = np.ascontiguousarray(scan.ranges, dtype=np.float64)
         beams = (scan.angle_min, scan.angle_increment, ranges.size)
         if self._beams is None or self._beams[0] != beams:  # the same laser, scan after scan
-            self._beams = (beams, scan.angle_min + scan.angle_increment
-                           * np.arange(ranges.size))
+            self._beams = (beams, np.asarray(scan.angle_min + scan.angle_increment
+                                             * np.arange(ranges.size), dtype=np.float64))
         alpha = self._beams[1]
         # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
         # robot); a return lies at the robot plus its range times that (Eq. 1 again).

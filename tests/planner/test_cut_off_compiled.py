@@ -39,7 +39,8 @@ def scipy_cut_off(cm: Costmap, start: npt.NDArray[np.float64], goal: npt.NDArray
 def walled(rng: np.random.Generator, nx: int, ny: int) -> npt.NDArray[np.bool_]:
     """Random walls: scattered cells, straight runs (whole rows and columns among them,
     which cut the grid in two) and rings, at several densities."""
-    walls = rng.random((nx, ny)) < rng.choice([0.0, 0.01, 0.05, 0.2])
+    walls = np.asarray(rng.random((nx, ny)) < float(rng.choice([0.0, 0.01, 0.05, 0.2])),
+                       dtype=np.bool_)
     for _ in range(int(rng.integers(0, 6))):
         if rng.random() < 0.5:
             i = int(rng.integers(0, nx))
