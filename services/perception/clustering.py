@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -181,10 +181,21 @@ def grid_index(coord: npt.ArrayLike, cell: float) -> IntArray:
     return np.floor(np.asarray(coord, dtype=np.float64) / cell + 0.5).astype(np.int64)
 
 
-def box_area(box: npt.ArrayLike) -> IntArray:
-    """Eq. 6: cells in an inclusive grid box ``(ix_min, ix_max, iy_min, iy_max)``."""
+# (A tuple is array-like too, so the two forms overlap for mypy; the tuple's comes first.)
+@overload
+def box_area(box: tuple[int, int, int, int]) -> int: ...  # type: ignore[overload-overlap]
+@overload
+def box_area(box: npt.ArrayLike) -> IntArray: ...
+def box_area(box: npt.ArrayLike) -> int | IntArray:
+    """Eq. 6: cells in an inclusive grid box ``(ix_min, ix_max, iy_min, iy_max)``, or in
+    each row of an array of boxes. One box as a tuple of Python ints (as the tracker keeps
+    them) gives a Python int, without the cost of a numpy call for four numbers."""
+    if isinstance(box, tuple):
+        cells: int = (box[1] - box[0] + 1) * (box[3] - box[2] + 1)
+        return cells
     b = np.asarray(box, dtype=np.int64)
-    return (b[..., 1] - b[..., 0] + 1) * (b[..., 3] - b[..., 2] + 1)
+    area: IntArray = (b[..., 1] - b[..., 0] + 1) * (b[..., 3] - b[..., 2] + 1)
+    return area
 
 
 def join_threshold(

@@ -1,9 +1,9 @@
 """The paper's obstacle-recognition equations (Eqs. 7-15) and decision tree, as pure functions.
 
-Grid boxes are inclusive ``(ix_min, ix_max, iy_min, iy_max)`` rows as produced by
-:func:`zenav.services.perception.clustering.cluster_scan`; the functions broadcast over
-leading dimensions, so ``box_cur[:, None, :]`` against ``box_prev[None, :, :]`` gives every
-(current x previous) pair at once.
+Grid boxes are inclusive ``(ix_min, ix_max, iy_min, iy_max)`` tuples, the rows produced by
+:func:`zenav.services.perception.clustering.cluster_scan`. Eqs. 7-14 are compiled
+(``_loops.pyx``), one function per equation for one pair; :func:`best_match` runs them over
+every (current x previous) pair of two chains.
 
 Decisions on points the paper leaves open
 -----------------------------------------
@@ -27,128 +27,30 @@ Decisions on points the paper leaves open
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-import numpy.typing as npt
-
 from zenav.services.geometry import wrap_degrees
 from zenav.services.perception.clustering import box_area
+from zenav.services.tracking import _loops
 
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
+Box = tuple[int, int, int, int]
 Kind = Literal["new", "static", "dynamic"]
 
 
-def overlap_cells(box_a: npt.ArrayLike, box_b: npt.ArrayLike) -> IntArray:
-    """Eqs. 7-9: number of grid cells shared by two inclusive boxes (0 when disjoint).
-
-    Eq. 8: disjoint when one box's max is below the other's min on x or on y. Eq. 9: sorting
-    the four x bounds x_b1 <= x_b2 <= x_b3 <= x_b4 of overlapping boxes, x_b2 is the larger of
-    the two mins and x_b3 the smaller of the two maxes, so the overlap holds
-    (x_b3 - x_b2 + 1) * (y_b3 - y_b2 + 1) cells (inclusive counting). A negative extent
-    means disjoint and is clipped to 0, which covers Eq. 8. Eq. 7 (full overlap) is the case
-    where both boxes are equal and the overlap is the whole area.
-    """
-    a = np.asarray(box_a, dtype=np.int64)
-    b = np.asarray(box_b, dtype=np.int64)
-    # Eq. 9, x_b3 - x_b2 + 1 and y_b3 - y_b2 + 1, both at once: the maxes are columns
-    # 1 and 3 of a box, the mins 0 and 2
-    extent = np.minimum(a[..., 1::2], b[..., 1::2]) - np.maximum(a[..., 0::2], b[..., 0::2]) + 1
-    # Eq. 8: no overlap when either extent is empty
-    np.maximum(extent, 0, out=extent)
-    inter: IntArray = extent[..., 0] * extent[..., 1]
-    return inter
+# Eqs. 7-14 are compiled (``_loops.pyx``): one function per equation, and
+# ``best_match``, which runs them over every (current, previous) pair of two chains. The
+# tracker calls ``best_match``; the equation tests pin each of these functions.
+overlap_cells = _loops.overlap_cells  # Eqs. 7-9
+union_cells = _loops.union_cells  # Eq. 10
+coincidence = _loops.coincidence  # Eq. 11
+non_overlap_rate = _loops.non_overlap_rate  # Eq. 13, eta
+centre_distance = _loops.centre_distance  # Eq. 13, delta (cells)
+spatial_correlation = _loops.spatial_correlation  # Eq. 12
 
 
-def union_cells(area_a: npt.ArrayLike, area_b: npt.ArrayLike, inter: npt.ArrayLike) -> IntArray:
-    """Eq. 10: cells covered by either box, S(t) + S(t-1) - S(t) n S(t-1)."""
-    return (
-        np.asarray(area_a, dtype=np.int64)
-        + np.asarray(area_b, dtype=np.int64)
-        - np.asarray(inter, dtype=np.int64)
-    )
-
-
-def coincidence(inter: npt.ArrayLike, area_cur: npt.ArrayLike) -> FloatArray:
-    """Eq. 11: xi = (S(t) n S(t-1)) / S(t), in [0, 1]."""
-    return np.asarray(inter, dtype=np.float64) / np.asarray(area_cur, dtype=np.float64)
-
-
-def non_overlap_rate(inter: npt.ArrayLike, union: npt.ArrayLike) -> FloatArray:
-    """Eq. 13: eta = 1 - (S1 n S2) / (S1 u S2): 0 for identical boxes, 1 for disjoint ones."""
-    return 1.0 - np.asarray(inter, dtype=np.float64) / np.asarray(union, dtype=np.float64)
-
-
-def centre_distance(centre_a: npt.ArrayLike, centre_b: npt.ArrayLike, cell: float) -> FloatArray:
-    """Eq. 13: delta = ||Z_k1(t) - Z_k2(t-1)||, in grid cells (metres / cell)."""
-    d = np.asarray(centre_a, dtype=np.float64) - np.asarray(centre_b, dtype=np.float64)
-    return np.hypot(d[..., 0], d[..., 1]) / cell
-
-
-def spatial_correlation(
-    delta: npt.ArrayLike, eta: npt.ArrayLike, y_delta: float = 0.5, y_eta: float = 0.5
-) -> FloatArray:
-    """Eq. 12: varsigma = y_delta / (delta + 1) + y_eta / (eta + 1).
-
-    With y_delta = y_eta = 0.5, delta >= 0 and eta in [0, 1], varsigma lies in (0.25, 1]:
-    1 for the same place and box, 0.25 in the limit of far and disjoint.
-    """
-    return y_delta / (np.asarray(delta, dtype=np.float64) + 1.0) + y_eta / (
-        np.asarray(eta, dtype=np.float64) + 1.0
-    )
-
-
-@dataclass(frozen=True, eq=False)
-class Correlation:
-    """Eqs. 9-13 for every (current k1, previous k2) pair; each array is (n_cur, n_prev)."""
-
-    inter: IntArray
-    union: IntArray
-    xi: FloatArray
-    eta: FloatArray
-    delta: FloatArray
-    varsigma: FloatArray
-
-
-def correlate(
-    centre_cur: npt.ArrayLike,
-    box_cur: npt.ArrayLike,
-    centre_prev: npt.ArrayLike,
-    box_prev: npt.ArrayLike,
-    *,
-    cell: float,
-    y_delta: float = 0.5,
-    y_eta: float = 0.5,
-) -> Correlation:
-    """All pairwise overlaps, coincidences and spatial correlations between two chains.
-
-    Args:
-        centre_cur: (n, 2) Eq. 5 centres at t, metres.
-        box_cur: (n, 4) grid boxes at t.
-        centre_prev: (m, 2) Eq. 5 centres at t-1.
-        box_prev: (m, 4) grid boxes at t-1.
-        cell: grid resolution r, metres (delta is in cells).
-        y_delta: weight of the distance term of Eq. 12.
-        y_eta: weight of the overlap term of Eq. 12.
-    """
-    bc = np.asarray(box_cur, dtype=np.int64).reshape(-1, 4)
-    bp = np.asarray(box_prev, dtype=np.int64).reshape(-1, 4)
-    cc = np.asarray(centre_cur, dtype=np.float64).reshape(-1, 2)
-    cp = np.asarray(centre_prev, dtype=np.float64).reshape(-1, 2)
-    area_c = box_area(bc)[:, None]  # Eq. 6
-    area_p = box_area(bp)[None, :]
-    inter = overlap_cells(bc[:, None, :], bp[None, :, :])  # Eqs. 7-9
-    union = union_cells(area_c, area_p, inter)  # Eq. 10
-    xi = coincidence(inter, area_c)  # Eq. 11
-    eta = non_overlap_rate(inter, union)  # Eq. 13
-    delta = centre_distance(cc[:, None, :], cp[None, :, :], cell)  # Eq. 13, cells
-    varsigma = spatial_correlation(delta, eta, y_delta, y_eta)  # Eq. 12
-    return Correlation(inter=inter, union=union, xi=xi, eta=eta, delta=delta, varsigma=varsigma)
-
-
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, slots=True)
 class BestMatch:
     """Eq. 14 per current obstacle, with the xi and delta of the maximising pair.
 
@@ -156,30 +58,40 @@ class BestMatch:
     empty (then varsigma_max = 0, delta = inf, xi = 0).
     """
 
-    varsigma_max: FloatArray
-    index: IntArray
-    delta: FloatArray
-    xi: FloatArray
+    varsigma_max: list[float]
+    index: list[int]
+    delta: list[float]
+    xi: list[float]
 
 
-def best_match(corr: Correlation) -> BestMatch:
-    """Eq. 14: varsigma_max over the previous chain (first maximum on ties)."""
-    n, m = corr.varsigma.shape
-    if m == 0:
-        return BestMatch(
-            varsigma_max=np.zeros(n),
-            index=np.full(n, -1, dtype=np.int64),
-            delta=np.full(n, np.inf),
-            xi=np.zeros(n),
-        )
-    j = np.argmax(corr.varsigma, axis=1)
-    rows = np.arange(n)
-    return BestMatch(
-        varsigma_max=corr.varsigma[rows, j],
-        index=j.astype(np.int64),
-        delta=corr.delta[rows, j],
-        xi=corr.xi[rows, j],
-    )
+def best_match(
+    centre_cur: Sequence[tuple[float, float]],
+    box_cur: Sequence[Box],
+    centre_prev: Sequence[tuple[float, float]],
+    box_prev: Sequence[Box],
+    *,
+    cell: float,
+    y_delta: float = 0.5,
+    y_eta: float = 0.5,
+) -> BestMatch:
+    """Eq. 14: varsigma_max of each current obstacle over the previous chain (the first
+    maximum on ties), from Eqs. 6 and 9-13 for every (current, previous) pair.
+
+    Args:
+        centre_cur: n Eq. 5 centres at t, metres.
+        box_cur: n grid boxes at t.
+        centre_prev: m Eq. 5 centres at t-1.
+        box_prev: m grid boxes at t-1.
+        cell: grid resolution r, metres (delta is in cells).
+        y_delta: weight of the distance term of Eq. 12.
+        y_eta: weight of the overlap term of Eq. 12.
+    """
+    v, j, delta, xi = _loops.best_match(
+        list(centre_cur), list(box_cur), [box_area(b) for b in box_cur],  # Eq. 6
+        list(centre_prev), list(box_prev), [box_area(b) for b in box_prev],
+        cell, y_delta, y_eta,
+    )  # fmt: skip
+    return BestMatch(varsigma_max=v, index=j, delta=delta, xi=xi)
 
 
 def classify(

@@ -51,21 +51,25 @@ from zenav.services.perception.clustering import (
     EDGE_FREE,
     EDGE_OCCLUDED,
     Clusters,
+    box_area,
     to_global,
 )
+from zenav.services.tracking import _loops
 from zenav.services.tracking.correlation import (
+    Box,
     Kind,
     alpha_o_from_heading,
     best_match,
     classify,
-    correlate,
     motion,
 )
 from zenav.services.tracking.params import TrackingParams
 
 Pose = tuple[float, float, float]
 FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
+Point = tuple[float, float]
+# One remembered chain: its stamp, Eq. 5 centres and grid boxes.
+Chain = tuple[float, list[Point], list[Box]]
 
 # A cluster that covers a second track counts as a union of the two (and its centre as
 # neither obstacle's) when its radius exceeds the track's by more than this, metres.
@@ -243,12 +247,6 @@ def _union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[
     return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
 
 
-def _cells(box: tuple[int, int, int, int]) -> int:
-    """Eq. 6 for one box of Python ints: the cells in it, as ``box_area`` counts them
-    (without the cost of a numpy call for four numbers)."""
-    return (box[1] - box[0] + 1) * (box[3] - box[2] + 1)
-
-
 class Tracker:
     """Frame-to-frame obstacle tracker (see the module notes).
 
@@ -264,8 +262,8 @@ class Tracker:
         self._tracks: list[_State] = []
         self._next_id = 1
         self._last_stamp: float | None = None
-        # chains to compare with: (stamp, Eq. 5 centres (k, 2), grid boxes (k, 4))
-        self._history: deque[tuple[float, FloatArray, IntArray]] = deque()
+        # chains to compare with: (stamp, Eq. 5 centres, grid boxes)
+        self._history: deque[Chain] = deque()
 
     def update(self, stamp: float, pose: Pose, clusters: Clusters) -> list[Track]:
         """Take one scan's obstacle chain and return every live track, sorted by id.
@@ -311,21 +309,20 @@ class Tracker:
 
         # Eqs. 11-14 against the chain compared with: xi, varsigma_max, delta (cells).
         order = sorted(meas)
-        centres = np.array([meas[i].centre for i in order], dtype=np.float64).reshape(-1, 2)
-        boxes = np.array([meas[i].box for i in order], dtype=np.int64).reshape(-1, 4)
+        centres = [meas[i].centre for i in order]
+        boxes = [meas[i].box for i in order]
         ref_stamp, ref_centres, ref_boxes = self._reference(stamp)
         best_xi: list[float] = []
         best_varsigma: list[float] = []
         best_delta: list[float] = []
         best_index: list[int] = []
         if order:  # (a frame without obstacles has nothing to compare)
-            corr = correlate(
+            best = best_match(
                 centres, boxes, ref_centres, ref_boxes,
                 cell=clusters.cell, y_delta=p.y_delta, y_eta=p.y_eta,
             )  # fmt: skip
-            best = best_match(corr)
-            best_xi, best_varsigma = best.xi.tolist(), best.varsigma_max.tolist()
-            best_delta, best_index = best.delta.tolist(), best.index.tolist()
+            best_xi, best_varsigma = best.xi, best.varsigma_max
+            best_delta, best_index = best.delta, best.index
 
         for row, ti in enumerate(order):
             t = self._tracks[ti]
@@ -354,8 +351,7 @@ class Tracker:
                 )  # fmt: skip
                 j = best_index[row]
                 if j >= 0:  # Eq. 15 between this frame and the chain compared with
-                    before = (float(ref_centres[j, 0]), float(ref_centres[j, 1]))
-                    mo = motion(m.centre, before, stamp - ref_stamp)
+                    mo = motion(m.centre, ref_centres[j], stamp - ref_stamp)
                     t.paper_vx, t.paper_vy, t.paper_d = mo.vx, mo.vy, mo.d_o
                 else:
                     t.paper_vx = t.paper_vy = t.paper_d = 0.0
@@ -367,7 +363,7 @@ class Tracker:
                 # in front or by the window edge neither grows nor shrinks it.
                 if not m.partial:
                     t.box = _union(t.box, m.box)
-                    t.area = _cells(t.box)
+                    t.area = box_area(t.box)  # Eq. 6
                     t.radius = max(t.radius, m.radius)
             elif ti not in coast:  # a coasting track keeps its own footprint
                 t.radius, t.box, t.area = m.radius, m.box, m.area
@@ -420,12 +416,10 @@ class Tracker:
         owner = [-1] * n
         if n == 0 or k == 0:
             return owner
-        pred = np.array([(t.x, t.y) for t in self._tracks], dtype=np.float64)
-        gate = np.array([t.radius for t in self._tracks], dtype=np.float64) + self.params.gate
-        dx = points[:, None, 0] - pred[None, :, 0]
-        dy = points[:, None, 1] - pred[None, :, 1]
-        dist = np.sqrt(dx * dx + dy * dy)
-        cost = np.where(dist <= gate[None, :], dist, _NO_MATCH)
+        # distance to each prediction within the track's gate (radius + gate), compiled
+        cost = _loops.gated_distances(np.ascontiguousarray(points, dtype=np.float64),
+                                      [(t.x, t.y, t.radius) for t in self._tracks],
+                                      self.params.gate, _NO_MATCH)
         rows, cols = linear_sum_assignment(cost)
         matched = (cost[rows, cols] < _NO_MATCH).tolist()
         for r, c, ok in zip(rows.tolist(), cols.tolist(), matched, strict=True):
@@ -579,27 +573,27 @@ class Tracker:
             point=(cx, cy) if use_chord else centre,
             radius=radius,
             box=box,
-            area=_cells(box),  # Eq. 6
+            area=box_area(box),  # Eq. 6
             partial=bool(
                 clusters.edge_start[first] != EDGE_FREE or clusters.edge_end[last] != EDGE_FREE
             ),
             n_parts=len(cl),
         )
 
-    def _reference(self, stamp: float) -> tuple[float, FloatArray, IntArray]:
+    def _reference(self, stamp: float) -> Chain:
         """The chain to compare with: the newest at least ``compare_dt`` old, else the oldest."""
         limit = stamp - self.params.compare_dt + _STAMP_SLACK
-        chosen: tuple[float, FloatArray, IntArray] | None = None
+        chosen: Chain | None = None
         for entry in self._history:
             if entry[0] <= limit:
                 chosen = entry
         if chosen is None and self._history:
             chosen = self._history[0]
         if chosen is None:
-            return stamp, np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64)
+            return stamp, [], []
         return chosen
 
-    def _remember(self, stamp: float, centres: FloatArray, boxes: IntArray) -> None:
+    def _remember(self, stamp: float, centres: list[Point], boxes: list[Box]) -> None:
         """Store this chain, dropping the ones no later frame can compare with."""
         self._history.append((stamp, centres, boxes))
         limit = stamp - self.params.compare_dt + _STAMP_SLACK

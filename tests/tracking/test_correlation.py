@@ -1,4 +1,5 @@
-"""Eqs. 7-15 and the decision tree against hand-worked numbers, and their invariants."""
+"""Eqs. 7-15 and the decision tree against hand-worked numbers, and their invariants; the
+compiled Eq. 14 over two chains against the numpy formulation it replaced, to the bit."""
 
 from __future__ import annotations
 
@@ -17,7 +18,6 @@ from zenav.services.tracking.correlation import (
     centre_distance,
     classify,
     coincidence,
-    correlate,
     motion,
     non_overlap_rate,
     overlap_cells,
@@ -28,7 +28,7 @@ from zenav.services.tracking.correlation import (
 CELL = 0.5
 
 
-def sorted_overlap(a: list[int], b: list[int]) -> int:
+def sorted_overlap(a: tuple[int, ...], b: tuple[int, ...]) -> int:
     """Eqs. 8-9 as the paper writes them: test disjointness, sort the bounds, count."""
     if a[1] < b[0] or a[0] > b[1] or a[3] < b[2] or a[2] > b[3]:  # Eq. 8
         return 0
@@ -44,7 +44,7 @@ def test_worked_overlap_example() -> None:
     # S(t): x 2..4, y 1..3 -> 3 x 3 = 9 cells. S(t-1): x 3..6, y 2..5 -> 4 x 4 = 16 cells.
     # x bounds sorted 2 <= 3 <= 4 <= 6: x_b2 = 3, x_b3 = 4 -> 4 - 3 + 1 = 2 columns;
     # y bounds sorted 1 <= 2 <= 3 <= 5: y_b2 = 2, y_b3 = 3 -> 2 rows. Overlap 4 cells.
-    cur, prev = [2, 4, 1, 3], [3, 6, 2, 5]
+    cur, prev = (2, 4, 1, 3), (3, 6, 2, 5)
     inter = overlap_cells(cur, prev)
     assert inter == 4
     union = union_cells(9, 16, inter)
@@ -56,35 +56,35 @@ def test_worked_overlap_example() -> None:
     delta = centre_distance((1.0, 1.0), (1.6, 1.8), CELL)
     assert delta == pytest.approx(2.0)
     assert spatial_correlation(delta, eta) == pytest.approx(0.442982, abs=1e-6)  # Eq. 12
-    corr = correlate([(1.0, 1.0)], [cur], [(1.6, 1.8)], [prev], cell=CELL)
-    assert corr.inter[0, 0] == 4
-    assert corr.union[0, 0] == 21
-    assert corr.xi[0, 0] == pytest.approx(4 / 9)
-    assert corr.varsigma[0, 0] == pytest.approx(0.442982, abs=1e-6)
+    best = best_match([(1.0, 1.0)], [cur], [(1.6, 1.8)], [prev], cell=CELL)
+    assert best.index == [0]
+    assert best.xi[0] == pytest.approx(4 / 9)
+    assert best.delta[0] == pytest.approx(2.0)
+    assert best.varsigma_max[0] == pytest.approx(0.442982, abs=1e-6)
 
 
 def test_identical_areas_give_varsigma_one_and_eta_zero() -> None:
     # The paper's case: same place, same box -> delta = 0, eta = 0, varsigma = 1 (Eq. 7).
-    box = [3, 5, -2, 0]
-    corr = correlate([(1.7, -0.4)], [box], [(1.7, -0.4)], [box], cell=CELL)
-    assert corr.inter[0, 0] == corr.union[0, 0] == 9
-    assert corr.eta[0, 0] == 0.0
-    assert corr.delta[0, 0] == 0.0
-    assert corr.xi[0, 0] == 1.0
-    assert corr.varsigma[0, 0] == 1.0
+    box = (3, 5, -2, 0)
+    assert overlap_cells(box, box) == union_cells(9, 9, 9) == 9
+    assert non_overlap_rate(9, 9) == 0.0
+    best = best_match([(1.7, -0.4)], [box], [(1.7, -0.4)], [box], cell=CELL)
+    assert best.delta == [0.0]
+    assert best.xi == [1.0]
+    assert best.varsigma_max == [1.0]
 
 
 @pytest.mark.parametrize(
     "prev",
     [
-        [0, 1, 0, 1],  # x_max(t-1) < x_min(t)
-        [6, 7, 2, 3],  # x_min(t-1) > x_max(t)
-        [2, 4, -3, 0],  # y_max(t-1) < y_min(t)
-        [2, 4, 4, 9],  # y_min(t-1) > y_max(t)
+        (0, 1, 0, 1),  # x_max(t-1) < x_min(t)
+        (6, 7, 2, 3),  # x_min(t-1) > x_max(t)
+        (2, 4, -3, 0),  # y_max(t-1) < y_min(t)
+        (2, 4, 4, 9),  # y_min(t-1) > y_max(t)
     ],
 )
-def test_isolated_areas_give_eta_one(prev: list[int]) -> None:
-    cur = [2, 4, 1, 3]
+def test_isolated_areas_give_eta_one(prev: tuple[int, int, int, int]) -> None:
+    cur = (2, 4, 1, 3)
     inter = overlap_cells(cur, prev)  # Eq. 8: no overlap
     assert inter == 0
     union = union_cells(9, int(np.prod([prev[1] - prev[0] + 1, prev[3] - prev[2] + 1])), inter)
@@ -96,52 +96,58 @@ def test_isolated_areas_give_eta_one(prev: list[int]) -> None:
 
 def test_boxes_sharing_one_column_overlap_by_inclusive_counting() -> None:
     # x 2..4 and 4..7 share column 4: x_b3 - x_b2 + 1 = 1, not 0.
-    assert overlap_cells([2, 4, 0, 0], [4, 7, 0, 0]) == 1
-    assert overlap_cells([2, 4, 0, 2], [4, 7, 1, 5]) == 2
+    assert overlap_cells((2, 4, 0, 0), (4, 7, 0, 0)) == 1
+    assert overlap_cells((2, 4, 0, 2), (4, 7, 1, 5)) == 2
 
 
 def test_full_overlap_of_a_box_inside_another() -> None:
     # Eq. 7 from the small box's side: the overlap is all of it.
-    assert overlap_cells([3, 4, 3, 4], [0, 9, 0, 9]) == 4
+    assert overlap_cells((3, 4, 3, 4), (0, 9, 0, 9)) == 4
     assert coincidence(4, 4) == 1.0
 
 
-def test_correlate_covers_every_pair() -> None:
+def test_best_match_covers_every_pair() -> None:
     cur_c = [(0.0, 0.0), (5.0, 5.0)]
-    cur_b = [[0, 0, 0, 0], [10, 10, 10, 10]]
+    cur_b = [(0, 0, 0, 0), (10, 10, 10, 10)]
     prev_c = [(0.0, 0.0), (5.0, 5.0), (9.0, 9.0)]
-    prev_b = [[0, 0, 0, 0], [10, 10, 10, 10], [18, 18, 18, 18]]
-    corr = correlate(cur_c, cur_b, prev_c, prev_b, cell=CELL)
-    assert corr.varsigma.shape == (2, 3)
-    assert corr.varsigma[0, 0] == corr.varsigma[1, 1] == 1.0
-    best = best_match(corr)  # Eq. 14
-    assert best.index.tolist() == [0, 1]
-    assert best.varsigma_max.tolist() == [1.0, 1.0]
-    assert best.xi.tolist() == [1.0, 1.0]
-    assert best.delta.tolist() == [0.0, 0.0]
+    prev_b = [(0, 0, 0, 0), (10, 10, 10, 10), (18, 18, 18, 18)]
+    best = best_match(cur_c, cur_b, prev_c, prev_b, cell=CELL)  # Eq. 14
+    assert best.index == [0, 1]
+    assert best.varsigma_max == [1.0, 1.0]
+    assert best.xi == [1.0, 1.0]
+    assert best.delta == [0.0, 0.0]
+    # the previous chain in the other order: each still finds its own
+    best = best_match(cur_c, cur_b, prev_c[::-1], prev_b[::-1], cell=CELL)
+    assert best.index == [2, 1]
 
 
 def test_best_match_with_no_previous_chain_is_new() -> None:
-    corr = correlate([(1.0, 1.0)], [[2, 2, 2, 2]], np.zeros((0, 2)), np.zeros((0, 4)), cell=CELL)
-    best = best_match(corr)
-    assert best.index.tolist() == [-1]
-    assert best.varsigma_max.tolist() == [0.0]
+    best = best_match([(1.0, 1.0)], [(2, 2, 2, 2)], [], [], cell=CELL)
+    assert best.index == [-1]
+    assert best.varsigma_max == [0.0]
     assert math.isinf(best.delta[0])
     assert classify(best.varsigma_max[0], best.delta[0], best.xi[0]) == "new"
+
+
+def test_best_match_takes_the_first_of_equal_maxima() -> None:
+    # two previous obstacles in the same place and box: the first one, as np.argmax
+    best = best_match([(0.0, 0.0)], [(0, 1, 0, 1)], [(3.0, 0.0), (0.0, 0.0), (0.0, 0.0)],
+                      [(6, 7, 0, 1), (0, 1, 0, 1), (0, 1, 0, 1)], cell=CELL)
+    assert best.index == [1] and best.varsigma_max == [1.0]
 
 
 def test_best_match_takes_the_maximum_over_the_previous_chain() -> None:
     # Eq. 14 by hand: previous obstacles 0.5 m (1 cell, disjoint) and 1.5 m (3 cells,
     # same box) away: 0.5/2 + 0.25 = 0.5 against 0.5/4 + 0.5 = 0.625 -> the second.
-    corr = correlate(
+    assert spatial_correlation(1.0, 1.0) == 0.5
+    assert spatial_correlation(3.0, 0.0) == 0.625
+    best = best_match(
         [(0.0, 0.0)],
-        [[0, 1, 0, 1]],
+        [(0, 1, 0, 1)],
         [(0.5, 0.0), (0.0, 1.5)],
-        [[5, 5, 5, 5], [0, 1, 0, 1]],
+        [(5, 5, 5, 5), (0, 1, 0, 1)],
         cell=CELL,
     )
-    np.testing.assert_allclose(corr.varsigma[0], [0.5, 0.625])
-    best = best_match(corr)
     assert best.index[0] == 1
     assert best.varsigma_max[0] == pytest.approx(0.625)
     assert best.delta[0] == pytest.approx(3.0)
@@ -212,31 +218,80 @@ def test_wrap_degrees_stays_below_360() -> None:
 
 # --- properties ------------------------------------------------------------------------
 
+Box = tuple[int, int, int, int]
 boxes = st.tuples(
     st.integers(-20, 20), st.integers(0, 6), st.integers(-20, 20), st.integers(0, 6)
-).map(lambda t: [t[0], t[0] + t[1], t[2], t[2] + t[3]])
+).map(lambda t: (t[0], t[0] + t[1], t[2], t[2] + t[3]))
 points = st.tuples(st.floats(-50, 50), st.floats(-50, 50))
 
 
+def area(b: Box) -> int:
+    return (b[1] - b[0] + 1) * (b[3] - b[2] + 1)
+
+
 @settings(max_examples=300, deadline=None)
-@given(cur=st.lists(st.tuples(points, boxes), min_size=1, max_size=5),
-       prev=st.lists(st.tuples(points, boxes), min_size=1, max_size=5))  # fmt: skip
-def test_varsigma_in_0_1_and_xi_in_0_1(cur: list[Any], prev: list[Any]) -> None:
-    corr = correlate(
-        [c for c, _ in cur], [b for _, b in cur], [c for c, _ in prev], [b for _, b in prev],
-        cell=CELL,
-    )  # fmt: skip
-    assert np.all(corr.varsigma > 0.0)
-    assert np.all(corr.varsigma <= 1.0)
-    assert np.all(corr.xi >= 0.0)
-    assert np.all(corr.xi <= 1.0)
-    assert np.all((corr.eta >= 0.0) & (corr.eta <= 1.0))
-    assert np.all(corr.inter <= corr.union)
+@given(a=boxes, b=boxes, ca=points, cb=points)
+def test_xi_eta_and_varsigma_stay_in_their_ranges(a: Box, b: Box, ca: tuple[float, float],
+                                                  cb: tuple[float, float]) -> None:
+    inter = overlap_cells(a, b)
+    union = union_cells(area(a), area(b), inter)
+    assert 0 <= inter <= union
+    assert 0.0 <= coincidence(inter, area(a)) <= 1.0
+    eta = non_overlap_rate(inter, union)
+    assert 0.0 <= eta <= 1.0
+    v = spatial_correlation(centre_distance(ca, cb, CELL), eta)
+    assert 0.0 < v <= 1.0
+
+
+def numpy_best_match(cc: Any, bc: Any, cp: Any, bp: Any, cell: float, y_delta: float,
+                     y_eta: float) -> tuple[list[float], list[int], list[float], list[float]]:
+    """Eqs. 6-14 as the tracker computed them before they were compiled: numpy over every
+    (current x previous) pair at once, then the first maximum per row."""
+    bc = np.asarray(bc, dtype=np.int64).reshape(-1, 4)
+    bp = np.asarray(bp, dtype=np.int64).reshape(-1, 4)
+    cc = np.asarray(cc, dtype=np.float64).reshape(-1, 2)
+    cp = np.asarray(cp, dtype=np.float64).reshape(-1, 2)
+    area_c = ((bc[:, 1] - bc[:, 0] + 1) * (bc[:, 3] - bc[:, 2] + 1))[:, None]
+    area_p = ((bp[:, 1] - bp[:, 0] + 1) * (bp[:, 3] - bp[:, 2] + 1))[None, :]
+    a, b = bc[:, None, :], bp[None, :, :]
+    extent = np.minimum(a[..., 1::2], b[..., 1::2]) - np.maximum(a[..., 0::2], b[..., 0::2]) + 1
+    np.maximum(extent, 0, out=extent)
+    inter = extent[..., 0] * extent[..., 1]
+    union = area_c + area_p - inter
+    xi = inter.astype(np.float64) / area_c.astype(np.float64)
+    eta = 1.0 - inter.astype(np.float64) / union.astype(np.float64)
+    d = cc[:, None, :] - cp[None, :, :]
+    delta = np.hypot(d[..., 0], d[..., 1]) / cell
+    varsigma = y_delta / (delta + 1.0) + y_eta / (eta + 1.0)
+    n, m = varsigma.shape
+    if m == 0:
+        return [0.0] * n, [-1] * n, [math.inf] * n, [0.0] * n
+    j = np.argmax(varsigma, axis=1)
+    rows = np.arange(n)
+    return (varsigma[rows, j].tolist(), j.tolist(), delta[rows, j].tolist(),
+            xi[rows, j].tolist())
+
+
+@settings(max_examples=300, deadline=None)
+@given(cur=st.lists(st.tuples(points, boxes), min_size=1, max_size=6),
+       prev=st.lists(st.tuples(points, boxes), min_size=0, max_size=6),
+       y_delta=st.floats(0.01, 1.0), cell=st.sampled_from([0.1, 0.25, 0.5]),
+       repeat=st.booleans())  # fmt: skip
+def test_best_match_is_the_numpy_formulation_to_the_bit(
+    cur: list[Any], prev: list[Any], y_delta: float, cell: float, repeat: bool
+) -> None:
+    if repeat and prev:
+        prev = [cur[0], *prev, cur[0]]  # equal maxima: the first one wins in both
+    args = ([c for c, _ in cur], [b for _, b in cur], [c for c, _ in prev],
+            [b for _, b in prev])
+    best = best_match(*args, cell=cell, y_delta=y_delta, y_eta=1.0 - y_delta)
+    want = numpy_best_match(*args, cell, y_delta, 1.0 - y_delta)
+    assert (best.varsigma_max, best.index, best.delta, best.xi) == want
 
 
 @settings(max_examples=300, deadline=None)
 @given(a=boxes, b=boxes)
-def test_overlap_matches_the_sorted_bounds_of_eq9(a: list[int], b: list[int]) -> None:
+def test_overlap_matches_the_sorted_bounds_of_eq9(a: Box, b: Box) -> None:
     assert overlap_cells(a, b) == sorted_overlap(a, b)
     assert overlap_cells(a, b) == overlap_cells(b, a)
 

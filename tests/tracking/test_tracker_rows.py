@@ -1,5 +1,6 @@
 """The tracker reads a chain's per-cluster values as Python numbers (``_Rows``); the
-motion score since a track's birth taken from them is numpy's masked maximum."""
+motion score since a track's birth taken from them is numpy's masked maximum, and the
+area of one box is Eq. 6 as ``box_area`` counts a row."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 from zenav.services.perception.clustering import Clusters, box_area
-from zenav.services.tracking.tracker import _cells, _moved_since_born, _Rows
+from zenav.services.tracking.tracker import _moved_since_born, _Rows
 
 
 def chain(each: np.ndarray, refs: np.ndarray) -> Clusters:
@@ -55,11 +56,14 @@ def test_without_the_per_scan_scores_the_chains_own_score_counts() -> None:
     assert [_moved_since_born(rows, c, 5.0) for c in range(2)] == [0.7, 0.1]
 
 
-def test_one_boxs_cells_are_eq6_as_box_area_counts_them() -> None:
+def test_one_box_as_a_tuple_is_eq6_as_the_array_form_counts_it() -> None:
+    """box_area's fast path for one box of Python ints (the tracker's) gives, as a Python
+    int, what its numpy form gives for the same rows."""
     rng = np.random.default_rng(3)
     lo = rng.integers(-50, 50, (200, 2))
     size = rng.integers(0, 20, (200, 2))
     boxes = np.column_stack([lo[:, 0], lo[:, 0] + size[:, 0], lo[:, 1], lo[:, 1] + size[:, 1]])
     want = box_area(boxes).tolist()
-    assert [_cells((a, b, c, d)) for a, b, c, d in boxes.tolist()] == want
-    assert _cells((2, 4, 1, 1)) == 3  # x 2..4 by y 1..1
+    got = [box_area((a, b, c, d)) for a, b, c, d in boxes.tolist()]
+    assert got == want and all(type(n) is int for n in got)
+    assert box_area((2, 4, 1, 1)) == 3  # x 2..4 by y 1..1
