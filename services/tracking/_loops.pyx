@@ -150,3 +150,36 @@ def gated_distances(const double[:, ::1] points, list tracks, double gate, doubl
             c[i, j] = dist if dist <= tr else no_match
     return cost
 
+
+
+def lone_pairs(const double[:, ::1] cost, double no_match):
+    """The pairs within their gate (cost < ``no_match``) as each row's column (-1: none),
+    when no row and no column has more than one; None when some do (then an assignment
+    has to choose between them).
+
+    With lone pairs only, every optimal assignment takes them all: one left out would
+    leave its row and column to pairs costing ``no_match`` each (or to nothing), which
+    taking it beats by about ``no_match``."""
+    cdef Py_ssize_t n = cost.shape[0]
+    cdef Py_ssize_t k = cost.shape[1]
+    cdef Py_ssize_t i, j, found
+    cdef list owner = [-1] * n
+    cdef unsigned char* taken = <unsigned char*>PyMem_Malloc(k if k > 0 else 1)
+    if taken == NULL:
+        raise MemoryError()
+    try:
+        for j in range(k):
+            taken[j] = 0
+        for i in range(n):
+            found = -1
+            for j in range(k):
+                if cost[i, j] < no_match:
+                    if found >= 0 or taken[j]:
+                        return None
+                    found = j
+                    taken[j] = 1
+            if found >= 0:
+                owner[i] = found
+    finally:
+        PyMem_Free(taken)
+    return owner

@@ -181,11 +181,12 @@ class _Measurement:
     n_parts: int
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class _Rows:
     """The per-cluster values of a chain the tracker reads one by one, as Python numbers
     (``tolist``: the same values; a numpy scalar costs more to index and convert than
-    the arithmetic done with it on a chain of a few obstacles)."""
+    the arithmetic done with it on a chain of a few obstacles). Built once per scan and
+    only read (not frozen: a frozen dataclass sets each field through a call)."""
 
     centre: list[tuple[float, float]]
     chord_centre: list[tuple[float, float]]
@@ -200,7 +201,9 @@ class _Rows:
     last_point: list[list[float]]
     moved: list[float] | None
     moved_each: list[list[float]] | None
-    moved_refs: list[float] | None
+    moved_refs: list[tuple[int, float]] | None
+    """(column of ``moved_each``, stamp) of each earlier scan compared with, those that
+    were remembered (a finite stamp)."""
 
     @staticmethod
     def of(clusters: Clusters) -> _Rows:
@@ -219,7 +222,8 @@ class _Rows:
             last_point=clusters.last_point.tolist(),
             moved=clusters.moved.tolist() if clusters.moved is not None else None,
             moved_each=each.tolist() if each is not None and refs is not None else None,
-            moved_refs=refs.tolist() if each is not None and refs is not None else None,
+            moved_refs=([(k, ref) for k, ref in enumerate(refs.tolist()) if math.isfinite(ref)]
+                        if each is not None and refs is not None else None),
         )  # fmt: skip
 
 
@@ -234,8 +238,10 @@ def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
         return rows.moved[c] if rows.moved is not None else 0.0
     limit = born - 1e-9
     best = 0.0
-    for ref, score in zip(rows.moved_refs, rows.moved_each[c], strict=True):
-        if math.isfinite(ref) and ref >= limit:
+    scores = rows.moved_each[c]
+    for k, ref in rows.moved_refs:
+        if ref >= limit:
+            score = scores[k]
             if math.isnan(score):
                 return math.nan
             best = score if score > best else best
@@ -420,6 +426,9 @@ class Tracker:
         cost = _loops.gated_distances(np.ascontiguousarray(points, dtype=np.float64),
                                       [(t.x, t.y, t.radius) for t in self._tracks],
                                       self.params.gate, _NO_MATCH)
+        lone = _loops.lone_pairs(cost, _NO_MATCH)
+        if lone is not None:
+            return lone  # no cluster or track with a choice: the assignment is these pairs
         rows, cols = linear_sum_assignment(cost)
         matched = (cost[rows, cols] < _NO_MATCH).tolist()
         for r, c, ok in zip(rows.tolist(), cols.tolist(), matched, strict=True):
