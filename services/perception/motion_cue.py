@@ -24,6 +24,7 @@ is used, so grazing surfaces and beam rounding do not read as free space.
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from dataclasses import dataclass
 
 import numpy as np
@@ -164,6 +165,7 @@ class MotionCue:
         self.reach = reach
         self.window_radius = window_radius
         self._scans: list[tuple[ScanSnapshot, IntArray, FloatArray]] = []
+        self._stamps: list[float] = []  # theirs, in the same order
 
     def score(self, scan: ScanSnapshot, range_min: float, cluster_beams: IntArray) -> FloatArray:
         """Scores for this scan's clusters (max over the baselines), then remember it."""
@@ -197,17 +199,17 @@ class MotionCue:
                     scores[:, j] = scores_against(clustered, scan, past[0], past[2],
                                                   self.margin)
         self._scans.append((scan, beams, points))
+        self._stamps.append(scan.stamp)
         oldest = scan.stamp - self.baselines[-1] - 1.0
-        while len(self._scans) > 1 and self._scans[1][0].stamp <= oldest:
-            self._scans.pop(0)
+        drop = 0
+        while len(self._stamps) - drop > 1 and self._stamps[drop + 1] <= oldest:
+            drop += 1
+        if drop:
+            del self._scans[:drop], self._stamps[:drop]
         return scores, stamps
 
     def _at_least(self, stamp: float) -> tuple[ScanSnapshot, IntArray, FloatArray] | None:
-        """The newest remembered scan taken at or before ``stamp``."""
-        found = None
-        for entry in self._scans:
-            if entry[0].stamp <= stamp + 1e-9:
-                found = entry
-            else:
-                break
-        return found
+        """The newest remembered scan taken at or before ``stamp`` (scans come in the
+        order of their stamps, as perception's stamp gate lets them through)."""
+        i = bisect_right(self._stamps, stamp + 1e-9)
+        return self._scans[i - 1] if i > 0 else None

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from zenav.schemas.messages import LaserScan
 from zenav.services.perception.clustering import Clusters, Pose, cluster_window, scan_window
 from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot
@@ -23,7 +21,8 @@ class Perceiver:
         window = scan_window(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min,
                              scan.range_max, pose, self.params.window_radius)
         clusters = cluster_window(window, scan.angle_increment, pose, self.params)
-        snapshot = ScanSnapshot(scan.stamp, pose, scan.ranges.astype(np.float64),
-                                scan.angle_min, scan.angle_increment, scan.range_max)
+        # (the window's ranges are the scan's as float64, the copy the cue keeps)
+        snapshot = ScanSnapshot(scan.stamp, pose, window.ranges, scan.angle_min,
+                                scan.angle_increment, scan.range_max)
         each, stamps = self.cue.score_each(snapshot, scan.range_min, clusters.beams, window)
         return clusters.with_motion(each, stamps)
