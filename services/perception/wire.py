@@ -81,25 +81,28 @@ def from_message(chain: ObstacleChain) -> Clusters:
     if not obs:
         return Clusters.empty(pose, chain.cell)
 
-    def floats(rows: list[tuple[float, float]]) -> np.ndarray:
-        return np.asarray(rows, dtype=np.float64).reshape(-1, 2)
-
+    # The float fields and the int fields of every obstacle in one array each, then each
+    # field's columns as an array of its own (contiguous, as perception made them).
+    f = np.array([(o.x, o.y, *o.first, *o.last, *o.chord, o.rho, o.alpha, o.radius, o.moved)
+                  for o in obs], dtype=np.float64)
+    i = np.array([(*o.cells, *o.beams, *o.edges, o.area, o.n_beams) for o in obs],
+                 dtype=np.int64)
     each, refs = _each_arrays(obs)
     return Clusters(
-        centre=floats([(o.x, o.y) for o in obs]),
-        mean_rho=np.asarray([o.rho for o in obs], dtype=np.float64),
-        mean_alpha=np.asarray([o.alpha for o in obs], dtype=np.float64),
-        box=np.asarray([o.cells for o in obs], dtype=np.int64).reshape(-1, 4),
-        area=np.asarray([o.area for o in obs], dtype=np.int64),
-        beams=np.asarray([o.beams for o in obs], dtype=np.int64).reshape(-1, 2),
-        n_beams=np.asarray([o.n_beams for o in obs], dtype=np.int64),
-        first_point=floats([o.first for o in obs]),
-        last_point=floats([o.last for o in obs]),
-        chord_centre=floats([o.chord for o in obs]),
-        radius=np.asarray([o.radius for o in obs], dtype=np.float64),
-        edge_start=np.asarray([o.edges[0] for o in obs], dtype=np.int64),
-        edge_end=np.asarray([o.edges[1] for o in obs], dtype=np.int64),
-        moved=np.asarray([o.moved for o in obs], dtype=np.float64),
+        centre=f[:, 0:2].copy(),
+        mean_rho=f[:, 8].copy(),
+        mean_alpha=f[:, 9].copy(),
+        box=i[:, 0:4].copy(),
+        area=i[:, 8].copy(),
+        beams=i[:, 4:6].copy(),
+        n_beams=i[:, 9].copy(),
+        first_point=f[:, 2:4].copy(),
+        last_point=f[:, 4:6].copy(),
+        chord_centre=f[:, 6:8].copy(),
+        radius=f[:, 10].copy(),
+        edge_start=i[:, 6].copy(),
+        edge_end=i[:, 7].copy(),
+        moved=f[:, 11].copy(),
         moved_each=each,
         moved_refs=refs,
         pose=pose,

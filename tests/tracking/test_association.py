@@ -58,7 +58,7 @@ def test_gated_distances_are_the_numpy_formulation_to_the_bit(seed: int) -> None
     rng = np.random.default_rng(seed)
     points = rng.normal(0.0, 3.0, (int(rng.integers(1, 12)), 2))
     pred = rng.normal(0.0, 3.0, (int(rng.integers(1, 12)), 2))
-    radius = rng.uniform(0.1, 1.0, pred.shape[0])
+    radius = rng.uniform(0.1, 1.0, (pred.shape[0],))
     gate = 0.8
     # the tracker's numpy code before it was compiled
     dx = points[:, None, 0] - pred[None, :, 0]
