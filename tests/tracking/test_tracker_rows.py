@@ -1,6 +1,7 @@
 """The tracker reads a chain's per-cluster values as Python numbers (``_Rows``); the
-motion score since a track's birth taken from them is numpy's masked maximum, and the
-area of one box is Eq. 6 as ``box_area`` counts a row."""
+motion score since a track's birth taken from them is numpy's masked maximum, the
+area of one box is Eq. 6 as ``box_area`` counts a row, and the output record is built
+field by field in order."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ import numpy as np
 import pytest
 
 from zenav.services.perception.clustering import Clusters, box_area
-from zenav.services.tracking.tracker import _moved_since_born, _Rows
+from zenav.services.tracking.correlation import alpha_o_from_heading
+from zenav.services.tracking.params import TrackingParams
+from zenav.services.tracking.tracker import Tracker, _moved_since_born, _Rows, _State
 
 
 def chain(each: np.ndarray, refs: np.ndarray) -> Clusters:
@@ -67,3 +70,28 @@ def test_one_box_as_a_tuple_is_eq6_as_the_array_form_counts_it() -> None:
     got = [box_area((a, b, c, d)) for a, b, c, d in boxes.tolist()]
     assert got == want and all(type(n) is int for n in got)
     assert box_area((2, 4, 1, 1)) == 3  # x 2..4 by y 1..1
+
+
+@pytest.mark.parametrize("method", ["smoothed", "paper"])
+def test_the_output_record_puts_each_value_in_its_named_field(method: str) -> None:
+    """``_output`` builds the Track positionally: each field gets the state's value of the
+    same name (every value distinct, so a swap shows)."""
+    state = _State(
+        id=7, kind="dynamic", x=1.25, y=-2.5, vx=0.3, vy=0.4, p00=0.01, p01=0.02, p11=0.03,
+        centre=(1.5, -2.25), radius=0.45, box=(2, 5, -6, -3), area=16, partial=False,
+        n_parts=1, xi=0.61, varsigma=0.83, delta=1.7, paper_vx=0.12, paper_vy=-0.16,
+        paper_d=0.02, age=9, last_seen=3.5, merged_since=None,
+    )  # fmt: skip
+    track = Tracker(TrackingParams(method=method))._output(state, 0.1, True)
+    vx, vy = (0.3, 0.4) if method == "smoothed" else (0.12, -0.16)
+    heading = math.atan2(vy, vx)
+    assert track._asdict() == {
+        "id": 7, "kind": "dynamic",
+        "x": 1.25 if method == "smoothed" else 1.5,
+        "y": -2.5 if method == "smoothed" else -2.25,
+        "vx": vx, "vy": vy, "speed": math.hypot(vx, vy), "heading": heading,
+        "alpha_o_deg": alpha_o_from_heading(heading),
+        "distance": math.hypot(vx, vy) * 0.1 if method == "smoothed" else 0.02,
+        "xi": 0.61, "varsigma": 0.83, "delta": 1.7, "radius": 0.45, "age": 9,
+        "last_seen": 3.5, "box": (2, 5, -6, -3), "area": 16, "visible": True,
+    }  # fmt: skip
