@@ -2,8 +2,9 @@
 liveliness, and a clean stop.
 
 A service declares its inputs with :meth:`Node.subscribe` (a topic and a handler) and
-its outputs with :meth:`Node.publisher`, then awaits :meth:`Node.spin`. Each input runs
-in its own asyncio task on one loop, so handlers never run concurrently. A payload that
+its outputs with :meth:`Node.publisher`, then awaits :meth:`Node.spin`. Every input is
+handled on one asyncio loop, as soon as its sample is buffered (no task in between), so
+handlers never run concurrently. A payload that
 does not decode is counted and logged (once per key and kind, then at most every
 ``LOG_EVERY`` seconds) and the service carries on; so does a handler that raises.
 """
@@ -11,6 +12,7 @@ does not decode is counted and logged (once per key and kind, then at most every
 from __future__ import annotations
 
 import asyncio
+import functools
 import inspect
 import logging
 import time
@@ -119,6 +121,7 @@ class Node:
         self.handler_errors = 0
         self._inputs: list[tuple[Subscription, Topic, Callable[[Any], Any]]] = []
         self._tasks: list[asyncio.Task[None]] = []
+        self._awaiting: set[asyncio.Task[None]] = set()  # handlers' awaitables in progress
         self._stop = asyncio.Event()
         self._token: Token | None = None
         self._accepted_wall = time.monotonic()
@@ -175,16 +178,16 @@ class Node:
         loop = asyncio.get_running_loop()
         self._token = self.bus.declare_token(self.keys.alive(self.name))
         for sub, topic, handler in self._inputs:
-            self._tasks.append(
-                loop.create_task(self._serve(sub, topic, handler), name=f"input:{topic.name}")
-            )
+            sub.consume(functools.partial(self._deliver, sub, topic, handler))
         self._tasks.append(loop.create_task(self._report_status(), name="status"))
         try:
             await self._stop.wait()
         finally:
-            for task in self._tasks:
+            for sub, _, _ in self._inputs:
+                sub.pause()
+            for task in (*self._tasks, *self._awaiting):
                 task.cancel()
-            await asyncio.gather(*self._tasks, return_exceptions=True)
+            await asyncio.gather(*self._tasks, *self._awaiting, return_exceptions=True)
             self._tasks.clear()
             for sub, _, _ in self._inputs:
                 sub.close()
@@ -192,31 +195,48 @@ class Node:
                 self._token.undeclare()
                 self._token = None
 
-    async def _serve(self, sub: Subscription, topic: Topic, handler: Callable[[Any], Any]) -> None:
-        while True:
-            key, payload = await sub.get()
-            try:
-                message = decode(payload, topic.message, key, topic.max_bytes)
-            except DecodeError as exc:
-                self.reject(key, exc.kind, str(exc))
-                continue
-            except Exception as exc:  # decode promises DecodeError; never lose the input task
-                self.reject(key, "invalid", f"{key}: invalid: {type(exc).__name__}: {exc}")
-                continue
-            refused = self.check_stamp(key, message.stamp)
-            if refused is not None:
-                self.reject(key, *refused)
-                continue
-            self.received[topic.name] += 1
-            try:
-                result = handler(message)
-                if inspect.isawaitable(result):
-                    await result
-            except asyncio.CancelledError:
-                raise
-            except Exception:
-                self.handler_errors += 1
-                log.exception("%s: handler for %s failed; input dropped", self.name, key)
+    def _deliver(self, sub: Subscription, topic: Topic, handler: Callable[[Any], Any],
+                 key: str, payload: bytes) -> None:
+        """One input sample, on the loop as soon as it is buffered: decode, check its
+        stamp, count it, handle it. A handler that returns an awaitable holds back this
+        input's next samples (buffered, newest wins) until it has finished."""
+        try:
+            message = decode(payload, topic.message, key, topic.max_bytes)
+        except DecodeError as exc:
+            self.reject(key, exc.kind, str(exc))
+            return
+        except Exception as exc:  # decode promises DecodeError; never lose the input
+            self.reject(key, "invalid", f"{key}: invalid: {type(exc).__name__}: {exc}")
+            return
+        refused = self.check_stamp(key, message.stamp)
+        if refused is not None:
+            self.reject(key, *refused)
+            return
+        self.received[topic.name] += 1
+        try:
+            result = handler(message)
+        except Exception:
+            self._handler_failed(key)
+            return
+        if inspect.isawaitable(result):
+            sub.pause()
+            task = asyncio.get_running_loop().create_task(self._finish(sub, key, result),
+                                                          name=f"input:{topic.name}")
+            self._awaiting.add(task)
+            task.add_done_callback(self._awaiting.discard)
+
+    async def _finish(self, sub: Subscription, key: str, result: Awaitable[Any]) -> None:
+        try:
+            await result
+        except asyncio.CancelledError:
+            raise
+        except Exception:
+            self._handler_failed(key)
+        sub.resume()
+
+    def _handler_failed(self, key: str) -> None:
+        self.handler_errors += 1
+        log.exception("%s: handler for %s failed; input dropped", self.name, key)
 
     def check_stamp(self, key: str, stamp: float) -> tuple[str, str] | None:
         """Order the inputs of one key by stamp, against the service's clock.

@@ -3,11 +3,12 @@
 Services see bytes in and bytes out; encoding lives in :mod:`zenav.schemas.codec`.
 
 Zenoh delivers samples on its own threads and has no asyncio API. The Zenoh callback
-here does one thing: hand the payload to the asyncio loop with
-``call_soon_threadsafe``. Everything else (decode, validate, compute) happens in the
-service's asyncio task, so nothing ever blocks a Zenoh thread. Each subscription keeps
-a bounded newest-wins buffer: when a consumer falls behind, the oldest sample is
-dropped and counted, and no queue grows without bound.
+here does one thing: put the payload into the subscription's buffer and, unless a
+wake-up is already on its way, wake the asyncio loop with ``call_soon_threadsafe``.
+Everything else (decode, validate, compute) happens on the service's loop, so nothing
+ever blocks a Zenoh thread. Each subscription keeps a bounded newest-wins buffer: when a
+consumer falls behind, the oldest sample is dropped and counted, and no queue grows
+without bound (not even the loop's own: one wake-up waits at most per subscription).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import contextlib
 import functools
 import json
 import logging
+import threading
 import uuid
 from abc import ABC, abstractmethod
 from collections import deque
@@ -72,47 +74,143 @@ class TransportConfig(BaseModel):
 class Subscription:
     """Samples of one key expression, buffered newest-wins for an asyncio consumer.
 
-    ``push`` must be called on the loop's thread; ``get`` awaits the next sample.
+    Two ways to consume: ``await get()`` (a task of the consumer's own), or
+    :meth:`consume`, where the loop calls a function with each sample as soon as it is
+    buffered, with no task to wake in between (a service's inputs: one loop iteration
+    less per message). Samples come in with ``push`` on the loop's thread (the in-memory
+    bus), or with ``offer`` from any thread (Zenoh's): the sample goes into the buffer
+    there and then, and the loop is woken once for all the samples that come before it
+    gets to them. Either way at most ``depth`` samples wait; a newer one drops the oldest
+    and counts it in ``dropped``.
     """
 
-    def __init__(self, key_expr: str, depth: int) -> None:
+    def __init__(self, key_expr: str, depth: int,
+                 loop: asyncio.AbstractEventLoop | None = None) -> None:
         if depth < 1:
             raise ValueError("a subscription needs a depth of at least 1")
         self.key_expr = key_expr
         self.depth = depth
         self.dropped = 0
         self._buffer: deque[tuple[str, bytes]] = deque()
+        self._lock = threading.Lock()  # the buffer, between Zenoh's thread and the loop's
         self._ready = asyncio.Event()
         self._closed = False
+        self._loop = loop
+        self._consumer: Callable[[str, bytes], None] | None = None
+        self._paused = False
+        self._wake_pending = False  # a wake-up is scheduled on the loop and not yet run
         self.on_close: Callable[[], None] | None = None
 
-    def push(self, key: str, payload: bytes) -> None:
-        if self._closed:
-            return
+    def _add(self, key: str, payload: bytes) -> None:
+        """Buffer a sample, newest wins (the caller holds the lock)."""
         if len(self._buffer) >= self.depth:
             self._buffer.popleft()
             self.dropped += 1
         self._buffer.append((key, payload))
-        self._ready.set()
+
+    def push(self, key: str, payload: bytes) -> None:
+        """Buffer a sample (on the loop's thread)."""
+        with self._lock:
+            if self._closed:
+                return
+            self._add(key, payload)
+            if self._consumer is None:
+                wake = False
+            else:
+                wake = not self._wake_pending
+                self._wake_pending = True
+        if self._consumer is None:
+            self._ready.set()
+        elif wake:
+            assert self._loop is not None  # set with the consumer
+            self._loop.call_soon(self._wake)
+
+    def offer(self, key: str, payload: bytes) -> None:
+        """Buffer a sample from any thread and wake the loop, unless a wake-up is already
+        on its way."""
+        with self._lock:
+            if self._closed:
+                return
+            self._add(key, payload)
+            if self._wake_pending:
+                return
+            self._wake_pending = True
+        if self._loop is not None:
+            with contextlib.suppress(RuntimeError):  # a closed loop: the process is stopping
+                self._loop.call_soon_threadsafe(self._wake)
+
+    def _wake(self) -> None:
+        """On the loop: hand every buffered sample to the consumer, oldest first, or wake
+        the task waiting in :meth:`get`."""
+        if self._consumer is None:
+            with self._lock:
+                self._wake_pending = False
+            self._ready.set()
+            return
+        while True:
+            with self._lock:
+                if self._closed or self._paused or not self._buffer:
+                    self._wake_pending = False
+                    return
+                key, payload = self._buffer.popleft()
+            try:
+                self._consumer(key, payload)
+            except BaseException:  # the loop reports it; the samples after it still come
+                with self._lock:
+                    self._wake_pending = False
+                self._schedule()
+                raise
+
+    def consume(self, consumer: Callable[[str, bytes], None]) -> None:
+        """From now on, call ``consumer(key, payload)`` on the loop for each sample, oldest
+        first, one at a time (call on the loop's thread). :meth:`get` is not for use then."""
+        self._loop = asyncio.get_running_loop()
+        self._consumer = consumer
+        self.resume()
+
+    def pause(self) -> None:
+        """Hand no more samples to the consumer until :meth:`resume`; they keep being
+        buffered (newest wins)."""
+        self._paused = True
+
+    def resume(self) -> None:
+        """Hand samples to the consumer again, those buffered meanwhile first."""
+        self._paused = False
+        self._schedule()
+
+    def _schedule(self) -> None:
+        """Wake the consumer on the loop's next turn if samples wait for it (on the loop)."""
+        with self._lock:
+            if (self._consumer is None or self._paused or self._closed or not self._buffer
+                    or self._wake_pending):
+                return
+            self._wake_pending = True
+        assert self._loop is not None
+        self._loop.call_soon(self._wake)
 
     async def get(self) -> tuple[str, bytes]:
         """The oldest buffered (key, payload); waits when there is none."""
-        while not self._buffer:
+        while True:
+            with self._lock:
+                if self._buffer:
+                    return self._buffer.popleft()
             if self._closed:
                 raise asyncio.CancelledError("subscription closed")
             self._ready.clear()
             await self._ready.wait()
-        return self._buffer.popleft()
 
     def pending(self) -> int:
         return len(self._buffer)
 
     def take(self) -> tuple[str, bytes] | None:
         """The oldest buffered (key, payload), or None; never waits."""
-        return self._buffer.popleft() if self._buffer else None
+        with self._lock:
+            return self._buffer.popleft() if self._buffer else None
 
     def close(self) -> None:
-        self._closed = True
+        with self._lock:
+            self._closed = True
+        self._consumer = None
         self._ready.set()
         if self.on_close is not None:
             self.on_close()
@@ -375,11 +473,11 @@ class ZenohBus(Bus):
         return _ZenohPublisher(pub)
 
     def subscribe(self, key_expr: str, depth: int = 1) -> Subscription:
-        sub = Subscription(key_expr, depth)
+        sub = Subscription(key_expr, depth, self._loop)
 
         def on_sample(sample: Any) -> None:
-            try:
-                self._to_loop(sub.push, str(sample.key_expr), sample.payload.to_bytes())
+            try:  # buffered here, newest wins; the loop is woken once per burst
+                sub.offer(str(sample.key_expr), sample.payload.to_bytes())
             except Exception:  # never let an exception reach Zenoh's thread
                 log.exception("zenoh callback failed on %s", key_expr)
 
