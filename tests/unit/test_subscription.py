@@ -16,7 +16,11 @@ from zenav.services.transport import InMemoryBus, Subscription
 
 
 def _offer_from_a_thread(sub: Subscription, payloads: list[bytes]) -> None:
-    thread = threading.Thread(target=lambda: [sub.offer("k", p) for p in payloads])
+    def offer_all() -> None:
+        for payload in payloads:
+            sub.offer("k", payload)
+
+    thread = threading.Thread(target=offer_all)
     thread.start()
     thread.join()
 
