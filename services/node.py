@@ -352,3 +352,60 @@ class StampGate:
         if stamp == self.last:
             return "repeat"
         return "old"
+
+
+A = TypeVar("A", bound=Message)
+B = TypeVar("B", bound=Message)
+
+
+class StampJoin(Generic[A, B]):
+    """Joins a message with its companion of the same stamp (a planner's track list with
+    the scan of that stamp), whichever of the two comes first, so that what the service
+    decides does not depend on their arrival order.
+
+    :meth:`companion` keeps the latest ``kept`` companions by stamp and completes the
+    message waiting for one. :meth:`arrive` decides a message at once when its companion
+    is in; else it waits, one at most, until its companion comes, until ``wait`` seconds
+    of the loop's clock have passed, or until a newer message arrives, whichever is
+    first; the last two decide it without one (``None``). ``decide(message, companion)``
+    is the service's.
+    """
+
+    def __init__(self, decide: Callable[[A, B | None], None], wait: float, kept: int) -> None:
+        self.decide = decide
+        self.wait = wait
+        self.kept = kept
+        self.companions: dict[float, B] = {}
+        """The latest companions, by stamp."""
+        self.pending: A | None = None
+        """The message waiting for its companion."""
+        self._timer: asyncio.TimerHandle | None = None
+
+    def companion(self, message: B) -> None:
+        self.companions[message.stamp] = message
+        while len(self.companions) > self.kept:
+            del self.companions[min(self.companions)]
+        if self.pending is not None and self.pending.stamp == message.stamp:
+            self._decide(self.pending, message)
+
+    def arrive(self, message: A) -> None:
+        if self.pending is not None:  # overtaken before its companion came: decided now
+            self._decide(self.pending, None)
+        companion = self.companions.get(message.stamp)
+        if companion is not None:
+            self._decide(message, companion)
+            return
+        self.pending = message
+        self._timer = asyncio.get_running_loop().call_later(self.wait, self._late,
+                                                            message.stamp)
+
+    def _late(self, stamp: float) -> None:
+        if self.pending is not None and self.pending.stamp == stamp:
+            self._decide(self.pending, None)
+
+    def _decide(self, message: A, companion: B | None) -> None:
+        self.pending = None
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        self.decide(message, companion)

@@ -7,8 +7,9 @@ It answers each track list with one velocity command stamped with the tracks' st
 (lockstep depends on it) and answers a repeated stamp by repeating its command. The
 scan that goes with a track list (same stamp; it usually arrives first, straight from
 the laser driver) and the odometry of that instant are kept by stamp. As in the paper
-planner's service, a decision waits for both halves of a stamp, whichever comes first,
-so that a loaded machine does not change the result: a track list whose scan has not
+planner's service (both join them with :class:`~zenav.services.node.StampJoin`), a
+decision waits for both halves of a stamp, whichever comes first, so that a loaded
+machine does not change the result: a track list whose scan has not
 come within ``scan_wait`` wall seconds (or is overtaken by a newer track list) is
 decided on the newest scan before it. Tracks give the robot pose
 at scan time and the movers. The planner state says ``a`` (no paper scenario) and the
@@ -18,7 +19,6 @@ published when the action changes.
 
 from __future__ import annotations
 
-import asyncio
 from typing import Protocol
 
 import numpy as np
@@ -40,7 +40,7 @@ from zenav.services.baselines.dwa import DWA
 from zenav.services.baselines.orca import ORCA
 from zenav.services.baselines.params import APFParams, DWAParams, ORCAParams, VFHParams
 from zenav.services.baselines.vfh import VFH
-from zenav.services.node import Node, StampGate
+from zenav.services.node import Node, StampGate, StampJoin
 from zenav.services.planner.params import MissionParams
 
 KEPT = 8
@@ -94,22 +94,17 @@ class BaselineService:
         self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
         self.gate = StampGate(node, keys.TRACKS)
-        self.scans: dict[float, LaserScan] = {}
+        # A track list and the scan of its stamp, joined (the latest few scans kept).
+        self.join = StampJoin[TrackList, LaserScan](self.decide, params.scan_wait, KEPT)
         self.odometry: dict[float, Odometry] = {}
         self.last_action: Action | None = None
         self.last_command = (0.0, 0.0)
-        self.pending: TrackList | None = None  # a track list waiting for its scan
-        self.timer: asyncio.TimerHandle | None = None
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=4)
         node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=8)
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
 
     def on_scan(self, scan: LaserScan) -> None:
-        self.scans[scan.stamp] = scan
-        while len(self.scans) > KEPT:
-            del self.scans[min(self.scans)]
-        if self.pending is not None and self.pending.stamp == scan.stamp:
-            self.decide(self.pending)
+        self.join.companion(scan)
 
     def on_odometry(self, odometry: Odometry) -> None:
         self.odometry[odometry.stamp] = odometry
@@ -132,31 +127,18 @@ class BaselineService:
     def on_tracks(self, tracks: TrackList) -> None:
         if not self.gate.admit(tracks.stamp, self.commands):
             return
-        if self.pending is not None:  # overtaken before its scan came: decide it now
-            self.decide(self.pending)
-        if tracks.stamp in self.scans:
-            self.decide(tracks)
-            return
-        self.pending = tracks
-        self.timer = asyncio.get_running_loop().call_later(
-            self.params.scan_wait, self._scan_late, tracks.stamp)
+        self.join.arrive(tracks)
 
-    def _scan_late(self, stamp: float) -> None:
-        if self.pending is not None and self.pending.stamp == stamp:
-            self.decide(self.pending)
-
-    def decide(self, tracks: TrackList) -> None:
+    def decide(self, tracks: TrackList, scan: LaserScan | None) -> None:
         """The command for ``tracks``, on the scan of its stamp or else the newest before."""
-        self.pending = None
-        if self.timer is not None:
-            self.timer.cancel()
-            self.timer = None
-        at = latest_at(self.scans, tracks.stamp)
+        if scan is None:  # not come in time: the newest before it
+            at = latest_at(self.join.companions, tracks.stamp)
+            scan = None if at is None else self.join.companions[at]
         v = omega = 0.0
         action: Action = "stop"
         detail = "no scan yet"
-        if at is not None:
-            cycle = self.cycle(tracks, self.scans[at])
+        if scan is not None:
+            cycle = self.cycle(tracks, scan)
             if goal_reached(cycle, self.params.goal_tolerance):
                 action, detail = "goal", "at the goal"
             else:

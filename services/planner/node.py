@@ -9,12 +9,12 @@ Joining the two halves of a stamp: a decision is made once both the track list a
 scan of one stamp are in, whichever came first, so the result does not depend on their
 arrival order. A track list whose scan has not come within ``scan_wait`` wall seconds
 (or is overtaken by a newer track list) is decided on without a map update or a stop
-zone check; the motor bridge's own stop zone still holds.
+zone check; the motor bridge's own stop zone still holds. The join is
+:class:`~zenav.services.node.StampJoin`'s, shared with the baselines' service.
 """
 
 from __future__ import annotations
 
-import asyncio
 from collections import deque
 
 import numpy as np
@@ -33,7 +33,7 @@ from zenav.schemas.messages import (
     TrackList,
     VelocityCommand,
 )
-from zenav.services.node import Node, StampGate
+from zenav.services.node import Node, StampGate, StampJoin
 from zenav.services.planner.costmap import ScanData
 from zenav.services.planner.decide import Decision, Planner
 from zenav.services.planner.params import Params
@@ -145,9 +145,8 @@ class Service:
         self.paths = node.publisher(keys.PATH, GlobalPath, reliable=True)
         self.maps = node.publisher(keys.MAP, OccupancyMap)
         self.gate = StampGate(node, keys.TRACKS)
-        self.scans: dict[float, LaserScan] = {}  # the latest few, by stamp
-        self.pending: TrackList | None = None  # a track list waiting for its scan
-        self.timer: asyncio.TimerHandle | None = None
+        # A track list and the scan of its stamp, joined (the latest few scans kept).
+        self.join = StampJoin[TrackList, LaserScan](self.decide, params.scan_wait, SCANS_KEPT)
         self.path_sent: PathKey | None = None  # what the last path published stood for
         self.path_last: GlobalPath | None = None  # and that message, for its repeats
         self.map_sent = -1.0  # stamp of the last map published
@@ -155,35 +154,14 @@ class Service:
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
 
     def on_scan(self, scan: LaserScan) -> None:
-        self.scans[scan.stamp] = scan
-        while len(self.scans) > SCANS_KEPT:
-            del self.scans[min(self.scans)]
-        if self.pending is not None and self.pending.stamp == scan.stamp:
-            self.decide(self.pending, scan)
+        self.join.companion(scan)
 
     def on_tracks(self, tracks: TrackList) -> None:
         if not self.gate.admit(tracks.stamp, self.commands):
             return
-        if self.pending is not None:  # overtaken before its scan came: decide it now
-            self.decide(self.pending, None)
-        scan = self.scans.get(tracks.stamp)
-        if scan is not None:
-            self.decide(tracks, scan)
-            return
-        self.pending = tracks
-        stamp = tracks.stamp
-        self.timer = asyncio.get_running_loop().call_later(
-            self.params.scan_wait, self._scan_late, stamp)
-
-    def _scan_late(self, stamp: float) -> None:
-        if self.pending is not None and self.pending.stamp == stamp:
-            self.decide(self.pending, None)
+        self.join.arrive(tracks)
 
     def decide(self, tracks: TrackList, scan: LaserScan | None) -> None:
-        self.pending = None
-        if self.timer is not None:
-            self.timer.cancel()
-            self.timer = None
         pose = tracks.pose
         xyh = (pose.x, pose.y, pose.heading)
         decision = self.planner.step(xyh, obstacles_of(tracks), tracks.stamp,
