@@ -58,6 +58,7 @@ def measure_latency(seconds: float, work: Path,
         listener.clear()
         time.sleep(seconds)
         rss = service_memory(stack)
+        listener.settle()
         with listener.lock:
             path = [dict(into) for _, into in listener.path()]
     _, scans, _, _, commands, base = path

@@ -4,9 +4,10 @@ benchmarks of ``zenav bench perf``."""
 from __future__ import annotations
 
 import contextlib
+import logging
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +18,9 @@ from zenav.schemas.keys import Keys, Topic
 from zenav.schemas.messages import BaseCommand, ServiceStatus
 from zenav.services.mission import stack_params
 from zenav.sim.scenario import load_scenario
-from zenav.tooling import SampleCallback, StampedSubscriber, ThreadedBus
+from zenav.tooling import StampedSubscriber, ThreadedBus
+
+log = logging.getLogger(__name__)
 
 
 class Listener:
@@ -25,7 +28,12 @@ class Listener:
     callback) of every scan, velocity command and base command by stamp (with ``hops``,
     of every message of the scan's path: also the raw frame, the obstacle chain and the
     track list), and the latest status per service. Its liveliness token ``bench`` is up
-    once it listens."""
+    once it listens.
+
+    The samples of the path are only stamped and kept as they come, on Zenoh's thread;
+    :meth:`settle` decodes them and files them by stamp. The listener's loop is not woken
+    for each of them: the observer takes no CPU from the stack it measures while the
+    stack works (it has two cores to share with it)."""
 
     def __init__(self, stack: Stack, hops: bool = False) -> None:
         self.k = Keys(stack.robot_id)
@@ -38,41 +46,61 @@ class Listener:
         self.commands: dict[float, float] = {}
         self.base: dict[float, float] = {}
         self.status: dict[str, ServiceStatus] = {}
+        self._heard: list[tuple[Topic, dict[float, float], str, bytes, int]] = []
+        self._heard_lock = threading.Lock()  # held only to append or to take the list
+        self._handles: list[Any] = []
         self._bus = ThreadedBus(stack.transport(driver=True))
         self._subscribers = self._bus.call(self._listen)
 
     def _listen(self) -> list[StampedSubscriber]:
         bus = self._bus.bus
-        subscribers = [StampedSubscriber(bus, self.k.of(topic), self._stamped(topic, into))
-                       for topic, into in self.path()
-                       if self.hops or topic in (keys.SCAN, keys.CMD_VEL, keys.BASE_CMD)]
-        subscribers.append(StampedSubscriber(bus, self.k.status_any, self._status))
+        for topic, into in self.path():
+            if self.hops or topic in (keys.SCAN, keys.CMD_VEL, keys.BASE_CMD):
+                self._handles.append(bus.session.declare_subscriber(
+                    self.k.of(topic), self._stamper(topic, into)))
+        subscribers = [StampedSubscriber(bus, self.k.status_any, self._status)]
         bus.declare_token(self.k.alive("bench"))
         return subscribers
 
     def path(self) -> tuple[tuple[Topic, dict[float, float]], ...]:
         """The topics of the scan's path through the stack, in order, each with the
-        receive times by stamp."""
+        receive times by stamp (of the samples settled so far)."""
         return ((keys.RAW_LASER, self.frames), (keys.SCAN, self.scans),
                 (keys.OBSTACLES, self.chains), (keys.TRACKS, self.tracks),
                 (keys.CMD_VEL, self.commands), (keys.BASE_CMD, self.base))
 
     def clear(self) -> None:
         """Forget every receive time so far (the start of a measured window)."""
+        with self._heard_lock:
+            self._heard = []
         with self.lock:
             for _, into in self.path():
                 into.clear()
 
-    def _stamped(self, topic: Topic, into: dict[float, float]) -> SampleCallback:
-        def on_sample(key: str, payload: bytes, received_ns: int) -> None:
-            with contextlib.suppress(DecodeError):
-                message = decode(payload, topic.message, key, topic.max_bytes)
-                if isinstance(message, BaseCommand) and message.reason != "command":
-                    return
-                with self.lock:
-                    into.setdefault(float(message.stamp), received_ns / 1e9)
+    def _stamper(self, topic: Topic, into: dict[float, float]) -> Callable[[Any], None]:
+        def on_sample(sample: Any) -> None:  # on Zenoh's thread
+            try:
+                now = time.time_ns()
+                heard = (topic, into, str(sample.key_expr), sample.payload.to_bytes(), now)
+                with self._heard_lock:
+                    self._heard.append(heard)
+            except Exception:  # never let an exception reach Zenoh's thread
+                log.exception("bench listener failed on %s", topic.name)
 
         return on_sample
+
+    def settle(self) -> None:
+        """Decode the samples heard since the last call and file their receive times by
+        stamp (a base command counts only when it passes on a command)."""
+        with self._heard_lock:
+            heard, self._heard = self._heard, []
+        with self.lock:
+            for topic, into, key, payload, received_ns in heard:
+                with contextlib.suppress(DecodeError):
+                    message = decode(payload, topic.message, key, topic.max_bytes)
+                    if isinstance(message, BaseCommand) and message.reason != "command":
+                        continue
+                    into.setdefault(float(message.stamp), received_ns / 1e9)
 
     def _status(self, key: str, payload: bytes, received_ns: int) -> None:
         with contextlib.suppress(DecodeError):
@@ -88,6 +116,9 @@ class Listener:
         def unsubscribe() -> None:
             for subscriber in self._subscribers:
                 subscriber.close()
+            for handle in self._handles:
+                with contextlib.suppress(Exception):  # already undeclared with the session
+                    handle.undeclare()
 
         with contextlib.suppress(Exception):
             self._bus.call(unsubscribe)
@@ -118,6 +149,7 @@ def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str
             failure = stack.failure()
             if failure:
                 raise RuntimeError(failure)
+            listener.settle()
             with listener.lock:
                 if listener.scans:
                     break

@@ -43,14 +43,13 @@ def measure_rate(rate: float, seconds: float, work: Path,
     with live_stack(copy, work / f"rate-{rate:g}", {}) as (_, listener):
         time.sleep(2.0)  # links settled, first status messages in
         before = listener.drops()
-        with listener.lock:
-            listener.scans.clear()
-            listener.base.clear()
+        listener.clear()
         started = time.perf_counter()
         time.sleep(seconds)
+        elapsed = time.perf_counter() - started
+        listener.settle()
         with listener.lock:
             scans, base = dict(listener.scans), dict(listener.base)
-        elapsed = time.perf_counter() - started
         time.sleep(1.2)  # one more status period
         after = listener.drops()
     # Scans in the last 0.2 s may still be on their way through the stack.
