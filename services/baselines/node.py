@@ -4,14 +4,18 @@ as the paper's planner. Algorithms: ``vfh.py``, ``dwa.py``, ``apf.py``, ``orca.p
 parameters: ``params.py``.
 
 It answers each track list with one velocity command stamped with the tracks' stamp
-(lockstep depends on it) and answers a repeated stamp by repeating its command. The
-scan that goes with a track list (same stamp; it usually arrives first, straight from
-the laser driver) and the odometry of that instant are kept by stamp. As in the paper
-planner's service (both join them with :class:`~zenav.services.node.StampJoin`), a
-decision waits for both halves of a stamp, whichever comes first, so that a loaded
-machine does not change the result: a track list whose scan has not
-come within ``scan_wait`` wall seconds (or is overtaken by a newer track list) is
-decided on the newest scan before it. Tracks give the robot pose
+(lockstep depends on it) and answers a repeated stamp by repeating its command. A
+baseline decides on the tracks, the scan of their stamp and the robot's velocity from
+the odometry of that instant (the newest at or before the stamp), the :class:`Instant`.
+An instant is complete once its scan is in and an odometry message at or after its
+stamp has come (so no later one can change which is the newest before it): in lockstep
+that is the odometry of the same tick; on a robot, the next odometry message. As in the
+paper planner's service (both join with :class:`~zenav.services.node.StampJoin`), a
+decision waits for the tracks and their instant, whichever comes first, so that a
+loaded machine does not change the result: a track list whose instant is not complete
+within ``scan_wait`` wall seconds (or that a newer track list overtakes) is decided on
+the scan of its stamp, else the newest before it, with the newest odometry at or before
+that scan. Tracks give the robot pose
 at scan time and the movers. The planner state says ``a`` (no paper scenario) and the
 action: ``keep`` when moving, ``stop`` when standing, ``goal`` at the goal; an event is
 published when the action changes.
@@ -19,6 +23,7 @@ published when the action changes.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -77,6 +82,15 @@ def movers_of(tracks: TrackList, moving_speed: float) -> tuple[Obstacles, Obstac
     return _obstacles(moving), _obstacles(standing)
 
 
+@dataclass(frozen=True)
+class Instant:
+    """The scan of a stamp and the odometry of that instant (None: none yet)."""
+
+    stamp: float
+    scan: LaserScan
+    odometry: Odometry | None
+
+
 def latest_at(kept: dict[float, LaserScan] | dict[float, Odometry], stamp: float) -> float | None:
     """The stamp of the kept message for ``stamp``: the same, else the newest before it."""
     if stamp in kept:
@@ -94,8 +108,10 @@ class BaselineService:
         self.events = node.publisher(keys.EVENTS, PlannerEvent, reliable=True)
         self.state = node.publisher(keys.PLANNER_STATE, PlannerState)
         self.gate = StampGate(node, keys.TRACKS)
-        # A track list and the scan of its stamp, joined (the latest few scans kept).
-        self.join = StampJoin[TrackList, LaserScan](self.decide, params.scan_wait, KEPT)
+        # A track list and the instant of its stamp, joined (the latest few kept).
+        self.join = StampJoin[TrackList, Instant](self.decide, params.scan_wait, KEPT)
+        self.scans: dict[float, LaserScan] = {}
+        """Scans whose instant is not complete yet: no odometry at or after them so far."""
         self.odometry: dict[float, Odometry] = {}
         self.last_action: Action | None = None
         self.last_command = (0.0, 0.0)
@@ -104,19 +120,41 @@ class BaselineService:
         node.subscribe(keys.TRACKS, TrackList, self.on_tracks, depth=2)
 
     def on_scan(self, scan: LaserScan) -> None:
-        self.join.companion(scan)
+        self.scans[scan.stamp] = scan
+        while len(self.scans) > KEPT:
+            del self.scans[min(self.scans)]
+        self._complete()
 
     def on_odometry(self, odometry: Odometry) -> None:
         self.odometry[odometry.stamp] = odometry
         while len(self.odometry) > KEPT:
             del self.odometry[min(self.odometry)]
+        self._complete()
 
-    def cycle(self, tracks: TrackList, scan: LaserScan) -> Cycle:
+    def _complete(self) -> None:
+        """Hand the join every instant now complete: its scan in, and an odometry message
+        at or after its stamp."""
+        newest = max(self.odometry, default=None)
+        if newest is None:
+            return
+        for stamp in sorted(s for s in self.scans if s <= newest):
+            self.join.companion(self._instant(stamp, self.scans.pop(stamp)))
+
+    def _instant(self, stamp: float, scan: LaserScan) -> Instant:
+        at = latest_at(self.odometry, stamp)
+        return Instant(stamp, scan, None if at is None else self.odometry[at])
+
+    def _fallback(self, stamp: float) -> Instant | None:
+        """A track list decided without its complete instant: the scan of its stamp, else
+        the newest before it, complete or not, with the newest odometry at or before it."""
+        scans = {s: i.scan for s, i in self.join.companions.items()} | self.scans
+        at = latest_at(scans, stamp)
+        return None if at is None else self._instant(at, scans[at])
+
+    def cycle(self, tracks: TrackList, instant: Instant) -> Cycle:
         p = self.params
-        at = latest_at(self.odometry, tracks.stamp)
-        velocity = self.last_command
-        if at is not None:
-            velocity = (self.odometry[at].v, self.odometry[at].omega)
+        scan, odometry = instant.scan, instant.odometry
+        velocity = self.last_command if odometry is None else (odometry.v, odometry.omega)
         pose = tracks.pose
         movers, remembered = movers_of(tracks, p.moving_speed)
         return Cycle(ranges=scan.ranges.astype(np.float64), angles=scan.angles(),
@@ -129,16 +167,15 @@ class BaselineService:
             return
         self.join.arrive(tracks)
 
-    def decide(self, tracks: TrackList, scan: LaserScan | None) -> None:
-        """The command for ``tracks``, on the scan of its stamp or else the newest before."""
-        if scan is None:  # not come in time: the newest before it
-            at = latest_at(self.join.companions, tracks.stamp)
-            scan = None if at is None else self.join.companions[at]
+    def decide(self, tracks: TrackList, instant: Instant | None) -> None:
+        """The command for ``tracks``, on the instant of its stamp, else what is in."""
+        if instant is None:  # not complete in time
+            instant = self._fallback(tracks.stamp)
         v = omega = 0.0
         action: Action = "stop"
         detail = "no scan yet"
-        if scan is not None:
-            cycle = self.cycle(tracks, scan)
+        if instant is not None:
+            cycle = self.cycle(tracks, instant)
             if goal_reached(cycle, self.params.goal_tolerance):
                 action, detail = "goal", "at the goal"
             else:

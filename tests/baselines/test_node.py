@@ -86,6 +86,7 @@ async def test_no_scan_yet_means_stop_and_the_goal_means_stop(name):
         h.send(keys.TRACKS, tracks(0.0))
         await h.settle()
         h.send(keys.SCAN, scan(0.1))
+        h.send(keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.0, omega=0.0))
         await h.settle()
         h.send(keys.TRACKS, tracks(0.1, Pose2D(x=7.95, y=5.0, heading=0.0)))
         await h.settle()
@@ -122,3 +123,32 @@ async def test_a_track_list_waits_for_the_scan_of_its_stamp(name):
     early = await _command_at_0_1(name, tracks_first=True)
     late = await _command_at_0_1(name, tracks_first=False)
     assert (early.v, early.omega) == (late.v, late.omega)
+
+
+async def _command_with_odometry(name: str, odometry_last: bool) -> VelocityCommand:
+    """The command for t = 0.1, the robot standing at 0.0 and moving at 0.5 m/s at 0.1,
+    the odometry of 0.1 coming before the scan and track list of 0.1 or after both."""
+    async with planner(name, cruise_speed=0.5) as h:
+        h.send(keys.SCAN, scan(0.0))
+        h.send(keys.ODOM, Odometry(stamp=0.0, seq=0, pose=POSE, v=0.0, omega=0.0))
+        await h.settle()
+        h.send(keys.TRACKS, tracks(0.0))
+        await h.settle()
+        odometry = (keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.5, omega=0.3))
+        rest = [(keys.SCAN, scan(0.1)), (keys.TRACKS, tracks(0.1))]
+        for key, message in rest + [odometry] if odometry_last else [odometry] + rest:
+            h.send(key, message)
+            await h.settle()
+        commands = h.received(keys.CMD_VEL, VelocityCommand)
+    assert [c.stamp for c in commands] == [0.0, 0.1]
+    return commands[1]
+
+
+@pytest.mark.parametrize("name", ["vfh", "dwa", "apf", "orca"])
+async def test_a_decision_waits_for_the_odometry_of_its_instant(name):
+    """Under load the odometry of a tick can come after its scan and track list: the
+    decision waits for it, so the robot's velocity a baseline plans from (DWA's window)
+    does not depend on the arrival order."""
+    first = await _command_with_odometry(name, odometry_last=False)
+    last = await _command_with_odometry(name, odometry_last=True)
+    assert (first.v, first.omega) == (last.v, last.omega)

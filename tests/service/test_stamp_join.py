@@ -16,7 +16,7 @@ import pytest
 from tests.service.harness import Harness
 from zenav.schemas import keys
 from zenav.schemas.keys import Keys
-from zenav.schemas.messages import LaserScan, Pose2D, TrackList, VelocityCommand
+from zenav.schemas.messages import LaserScan, Odometry, Pose2D, TrackList, VelocityCommand
 from zenav.services.node import Node, StampJoin
 from zenav.services.runner import PLANNERS, implementation
 from zenav.services.transport import InMemoryBus
@@ -46,6 +46,13 @@ def scan(t: float) -> LaserScan:
                      range_max=8.0, ranges=np.full(361, 8.0, dtype=np.float32))
 
 
+def send_scan(h: Harness, t: float) -> None:
+    """The scan of ``t`` and the odometry of that tick, as the simulator sends them (a
+    baseline's instant needs both; the paper planner's join takes the scan alone)."""
+    h.send(keys.ODOM, Odometry(stamp=t, seq=0, pose=POSE, v=0.0, omega=0.0))
+    h.send(keys.SCAN, scan(t))
+
+
 def tracks(t: float) -> TrackList:
     return TrackList(stamp=t, seq=0, pose=POSE, tracks=[])
 
@@ -58,7 +65,7 @@ def answered(h: Harness) -> list[float]:
 async def test_every_planner_joins_a_track_list_with_the_scan_of_its_stamp(name: str) -> None:
     async with planner(name) as h:
         assert isinstance(h.service.join, StampJoin)
-        h.send(keys.SCAN, scan(0.0))
+        send_scan(h, 0.0)
         await h.settle()
         h.send(keys.TRACKS, tracks(0.0))  # its scan is in: decided at once
         await h.settle()
@@ -67,7 +74,7 @@ async def test_every_planner_joins_a_track_list_with_the_scan_of_its_stamp(name:
         await h.settle()
         assert answered(h) == [0.0]
         assert h.service.join.pending is not None and h.service.join.pending.stamp == 0.1
-        h.send(keys.SCAN, scan(0.1))  # and decided the moment it comes
+        send_scan(h, 0.1)  # and decided the moment it comes
         await h.settle()
         assert answered(h) == [0.0, 0.1]
         assert h.service.join.pending is None
@@ -85,7 +92,7 @@ async def test_a_held_track_list_is_decided_when_overtaken_or_after_the_wait(
         await asyncio.sleep(0.15)  # 0.2's scan does not come within scan_wait either
         await h.settle()
         assert answered(h) == [0.1, 0.2]
-        h.send(keys.SCAN, scan(0.2))  # too late: nothing more to decide
+        send_scan(h, 0.2)  # too late: nothing more to decide
         await h.settle()
         assert answered(h) == [0.1, 0.2]
 
@@ -94,7 +101,7 @@ async def test_a_held_track_list_is_decided_when_overtaken_or_after_the_wait(
 async def test_only_the_latest_scans_are_kept(name: str) -> None:
     async with planner(name) as h:
         for k in range(12):
-            h.send(keys.SCAN, scan(round(0.1 * k, 6)))
+            send_scan(h, round(0.1 * k, 6))
             await h.settle()
         kept = sorted(h.service.join.companions)
         assert kept == [round(0.1 * k, 6) for k in range(12 - h.service.join.kept, 12)]
