@@ -354,8 +354,15 @@ class StampGate:
         return "old"
 
 
+class Stamped(Protocol):
+    """Anything with a stamp: a message, or what a service builds from several."""
+
+    @property
+    def stamp(self) -> float: ...
+
+
 A = TypeVar("A", bound=Message)
-B = TypeVar("B", bound=Message)
+B = TypeVar("B", bound=Stamped)
 
 
 class StampJoin(Generic[A, B]):

@@ -4,19 +4,17 @@ change of action."""
 
 from __future__ import annotations
 
-import asyncio
 import math
-from collections.abc import AsyncIterator
-from contextlib import asynccontextmanager
 
 import numpy as np
 import pytest
 
-from tests.service.harness import Harness
+from tests.service.harness import planner
 from zenav.schemas import keys
-from zenav.schemas.keys import Keys
+from zenav.schemas.keys import Topic
 from zenav.schemas.messages import (
     LaserScan,
+    Message,
     Odometry,
     PlannerEvent,
     PlannerState,
@@ -24,27 +22,9 @@ from zenav.schemas.messages import (
     TrackList,
     VelocityCommand,
 )
-from zenav.services.node import Node
-from zenav.services.runner import PLANNERS, implementation
-from zenav.services.transport import InMemoryBus
+from zenav.services.runner import PLANNERS
 
 POSE = Pose2D(x=2.0, y=5.0, heading=0.0)
-
-
-@asynccontextmanager
-async def planner(name: str, **params: object) -> AsyncIterator[Harness]:
-    bus = InMemoryBus()
-    k = Keys("test")
-    node = Node("planner", bus, k)
-    module = implementation("planner", name)
-    service = module.Service(node, module.Params(goal=(8.0, 5.0), **params))
-    task = asyncio.create_task(node.spin())
-    await asyncio.sleep(0)
-    try:
-        yield Harness(bus, k, node, service)
-    finally:
-        node.request_stop()
-        await asyncio.gather(task, return_exceptions=True)
 
 
 def scan(t: float, ranges: float = 8.0) -> LaserScan:
@@ -97,18 +77,17 @@ async def test_no_scan_yet_means_stop_and_the_goal_means_stop(name):
     assert all(e.scenario == "a" for e in events)
 
 
-async def _command_at_0_1(name: str, tracks_first: bool) -> VelocityCommand:
-    """The command for t = 0.1 when the scan of that stamp shows a wall 0.4 m ahead (the
-    one before showed open road), the track list coming before or after that scan."""
-    async with planner(name, cruise_speed=0.2) as h:
+async def _command_at_0_1(name: str, cruise_speed: float, v0: float,
+                          messages: list[tuple[Topic, Message]]) -> VelocityCommand:
+    """The command for t = 0.1: a first tick at 0.0 on open road with the robot at
+    ``v0`` m/s, then the messages of 0.1 in the order given."""
+    async with planner(name, cruise_speed=cruise_speed) as h:
         h.send(keys.SCAN, scan(0.0))
-        h.send(keys.ODOM, Odometry(stamp=0.0, seq=0, pose=POSE, v=0.2, omega=0.0))
+        h.send(keys.ODOM, Odometry(stamp=0.0, seq=0, pose=POSE, v=v0, omega=0.0))
         await h.settle()
         h.send(keys.TRACKS, tracks(0.0))
         await h.settle()
-        h.send(keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.2, omega=0.0))
-        halves = [(keys.TRACKS, tracks(0.1)), (keys.SCAN, scan(0.1, ranges=0.4))]
-        for key, message in halves if tracks_first else reversed(halves):
+        for key, message in messages:
             h.send(key, message)
             await h.settle()
         commands = h.received(keys.CMD_VEL, VelocityCommand)
@@ -120,28 +99,11 @@ async def _command_at_0_1(name: str, tracks_first: bool) -> VelocityCommand:
 async def test_a_track_list_waits_for_the_scan_of_its_stamp(name):
     """Under load a track list can come before its own scan: the decision waits for it,
     so the command does not depend on the arrival order (lockstep runs stay the same)."""
-    early = await _command_at_0_1(name, tracks_first=True)
-    late = await _command_at_0_1(name, tracks_first=False)
+    odometry = (keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.2, omega=0.0))
+    halves = [(keys.TRACKS, tracks(0.1)), (keys.SCAN, scan(0.1, ranges=0.4))]  # a wall
+    early = await _command_at_0_1(name, 0.2, 0.2, [odometry, *halves])
+    late = await _command_at_0_1(name, 0.2, 0.2, [odometry, *reversed(halves)])
     assert (early.v, early.omega) == (late.v, late.omega)
-
-
-async def _command_with_odometry(name: str, odometry_last: bool) -> VelocityCommand:
-    """The command for t = 0.1, the robot standing at 0.0 and moving at 0.5 m/s at 0.1,
-    the odometry of 0.1 coming before the scan and track list of 0.1 or after both."""
-    async with planner(name, cruise_speed=0.5) as h:
-        h.send(keys.SCAN, scan(0.0))
-        h.send(keys.ODOM, Odometry(stamp=0.0, seq=0, pose=POSE, v=0.0, omega=0.0))
-        await h.settle()
-        h.send(keys.TRACKS, tracks(0.0))
-        await h.settle()
-        odometry = (keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.5, omega=0.3))
-        rest = [(keys.SCAN, scan(0.1)), (keys.TRACKS, tracks(0.1))]
-        for key, message in rest + [odometry] if odometry_last else [odometry] + rest:
-            h.send(key, message)
-            await h.settle()
-        commands = h.received(keys.CMD_VEL, VelocityCommand)
-    assert [c.stamp for c in commands] == [0.0, 0.1]
-    return commands[1]
 
 
 @pytest.mark.parametrize("name", ["vfh", "dwa", "apf", "orca"])
@@ -149,6 +111,8 @@ async def test_a_decision_waits_for_the_odometry_of_its_instant(name):
     """Under load the odometry of a tick can come after its scan and track list: the
     decision waits for it, so the robot's velocity a baseline plans from (DWA's window)
     does not depend on the arrival order."""
-    first = await _command_with_odometry(name, odometry_last=False)
-    last = await _command_with_odometry(name, odometry_last=True)
+    odometry = (keys.ODOM, Odometry(stamp=0.1, seq=0, pose=POSE, v=0.5, omega=0.3))
+    rest = [(keys.SCAN, scan(0.1)), (keys.TRACKS, tracks(0.1))]
+    first = await _command_at_0_1(name, 0.5, 0.0, [odometry, *rest])
+    last = await _command_at_0_1(name, 0.5, 0.0, [*rest, odometry])
     assert (first.v, first.omega) == (last.v, last.omega)

@@ -57,3 +57,22 @@ async def running(name: str, params: Any) -> AsyncIterator[Harness]:
         if run_task is not None:
             run_task.cancel()
         await asyncio.gather(task, *( [run_task] if run_task else []), return_exceptions=True)
+
+
+@asynccontextmanager
+async def planner(name: str, **params: Any) -> AsyncIterator[Harness]:
+    """The planner service of implementation ``name`` (paper, vfh, dwa, apf, orca) on the
+    in-memory bus, going from (2, 5) to (8, 5) unless ``params`` say otherwise."""
+    bus = InMemoryBus()
+    keys = Keys("test")
+    node = Node("planner", bus, keys)
+    module = implementation("planner", name)
+    service = module.Service(node, module.Params(**({"goal": (8.0, 5.0), "start": (2.0, 5.0)}
+                                                     | params)))
+    task = asyncio.create_task(node.spin())
+    await asyncio.sleep(0)
+    try:
+        yield Harness(bus, keys, node, service)
+    finally:
+        node.request_stop()
+        await asyncio.gather(task, return_exceptions=True)

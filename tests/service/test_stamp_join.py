@@ -7,37 +7,17 @@ from __future__ import annotations
 
 import asyncio
 import math
-from collections.abc import AsyncIterator
-from contextlib import asynccontextmanager
 
 import numpy as np
 import pytest
 
-from tests.service.harness import Harness
+from tests.service.harness import Harness, planner
 from zenav.schemas import keys
-from zenav.schemas.keys import Keys
 from zenav.schemas.messages import LaserScan, Odometry, Pose2D, TrackList, VelocityCommand
-from zenav.services.node import Node, StampJoin
-from zenav.services.runner import PLANNERS, implementation
-from zenav.services.transport import InMemoryBus
+from zenav.services.node import StampJoin
+from zenav.services.runner import PLANNERS
 
 POSE = Pose2D(x=2.0, y=5.0, heading=0.0)
-
-
-@asynccontextmanager
-async def planner(name: str, **params: object) -> AsyncIterator[Harness]:
-    bus = InMemoryBus()
-    k = Keys("test")
-    node = Node("planner", bus, k)
-    module = implementation("planner", name)
-    service = module.Service(node, module.Params(goal=(8.0, 5.0), start=(2.0, 5.0), **params))
-    task = asyncio.create_task(node.spin())
-    await asyncio.sleep(0)
-    try:
-        yield Harness(bus, k, node, service)
-    finally:
-        node.request_stop()
-        await asyncio.gather(task, return_exceptions=True)
 
 
 def scan(t: float) -> LaserScan:
