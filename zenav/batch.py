@@ -69,6 +69,16 @@ class Records(dict[str, dict[str, Any]]):
         self.disagreements: list[str] = []  # "key: where the records part"
 
 
+def verified_note(records: Records) -> str:
+    """What the stack said of the in-process runs it re-made, for a report's header."""
+    if not records.verified:
+        return ""
+    if records.disagreements:
+        return (f"; {len(records.disagreements)} of {len(records.verified)} runs re-made "
+                f"through the stack DISAGREE")
+    return f"; {len(records.verified)} runs re-made through the stack agree tick by tick"
+
+
 def error_record(job: Job, error: str) -> dict[str, Any]:
     """The record of a run that failed: outcome ``error`` and the one-line reason."""
     return {"scenario": job.name, "planner": job.planner, "outcome": "error", "error": error}

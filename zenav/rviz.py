@@ -132,6 +132,9 @@ async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None
     view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame,
                     path_topic=args.path_topic, map_topic=args.map_topic)
     task = asyncio.get_running_loop().create_task(view.run())
+    print(f"zenav rviz: robot {robot_id}'s tracks and planner state to {args.topic}, its path "
+          f"to {args.path_topic} and its map to {args.map_topic} (ROS_DOMAIN_ID "
+          f"{args.domain_id}, frame {args.frame}); Ctrl-C stops", flush=True)
     try:
         await stop.wait()
     finally:

@@ -74,6 +74,7 @@ def test_the_eight_settings():
     ((["orca"], ["circle-invisible-180"], 0, "stack", 1), "--cases must be >= 1 (got 0)"),
     ((["orca"], ["circle-invisible-180"], 1, "warp", 1), "unknown engine 'warp'"),
     ((["orca"], ["circle-invisible-180"], 1, "stack", 0), "--jobs must be >= 1 (got 0)"),
+    ((["orca"], ["circle-invisible-180"], 1, "stack", 1, -1), "--verify must be >= 0 (got -1)"),
 ])
 def test_bad_arguments_are_one_line(args, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
@@ -111,3 +112,39 @@ def test_a_sweep_makes_every_run_again_unless_told_to_reuse(tmp_path, monkeypatc
     rows = json.loads((tmp_path / "crowd.json").read_text())["settings"]
     assert rows["circle-invisible-360"][0]["collision"] == (0.5 if reuse else 0.0)
     assert ("--reuse" in report) == reuse
+
+
+@pytest.mark.parametrize("disagree", [False, True])
+def test_the_report_says_what_the_stack_said_of_the_runs_it_made_again(tmp_path, monkeypatch,
+                                                                        disagree):
+    """The sweep asks the engine for ``verify`` stack re-runs, and the report's header and
+    crowd.json say whether they agreed, loudly when they did not."""
+    import json
+
+    from zenav import batch
+    from zenav.bench import crowd
+
+    asked: list[int] = []
+
+    def engine(jobs, parallel, on_done, reuse, verify):
+        asked.append(verify)
+        records = batch.Records()
+        for job in jobs:
+            records[job.key] = record(job.planner, "reached", 10.0, [1.0])
+            on_done(job, records[job.key])
+        records.verified = [jobs[0].key]
+        records.disagreements = [f"{jobs[0].key}: tick 3: x differs"] if disagree else []
+        return records
+
+    monkeypatch.setitem(crowd.ENGINES, "inprocess", engine)
+    report = crowd.run_crowd(["paper"], tmp_path, cases=2, settings=["circle-invisible-360"],
+                             jobs=1, progress=False, verify=5, echo=lambda text: None)
+
+    assert asked == [5]
+    assert "--verify 5" in report
+    said = ("1 of 1 runs re-made through the stack DISAGREE" if disagree
+            else "1 runs re-made through the stack agree tick by tick")
+    assert said in report
+    summary = json.loads((tmp_path / "crowd.json").read_text())
+    assert summary["verified"] == ["circle-invisible-360/paper/0"]
+    assert len(summary["disagreements"]) == int(disagree)

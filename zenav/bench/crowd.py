@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from zenav.batch import Job, run_batch
+from zenav.batch import DEFAULT_VERIFY, Job, Records, run_batch, verified_note
 from zenav.bench.common import machine, words
 from zenav.sim.crowdnav import (
     DISCOMFORT,
@@ -45,10 +45,11 @@ __all__ = ["ENGINES", "SETTINGS", "Setting", "discomfort_steps", "run_crowd", "s
 
 Record = dict[str, Any]
 OnDone = Callable[[Job, Record], None]
-Engine = Callable[[Sequence[Job], int, OnDone, bool], dict[str, Record]]
-"""(jobs, runs at a time, called as each run ends, reuse) -> the records by job key. A run
-that fails gives a record with outcome ``error``; with ``reuse``, a ``run.json`` already in
-a run's directory is its record."""
+Engine = Callable[[Sequence[Job], int, OnDone, bool, int], Records]
+"""(jobs, runs at a time, called as each run ends, reuse, verify) -> the records by job
+key. A run that fails gives a record with outcome ``error``; with ``reuse``, a
+``run.json`` already in a run's directory is its record; ``verify``: how many in-process
+runs are made again through the stack and compared (the stack engine has none to check)."""
 
 
 @dataclass(frozen=True)
@@ -76,19 +77,20 @@ PLANNERS = ("paper", "vfh", "dwa", "apf", "orca")
 
 
 def stack_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone,
-                 reuse: bool = False) -> dict[str, Record]:
-    """Every job through ``zenav run``'s path (the whole service stack, lockstep)."""
+                 reuse: bool = False, verify: int = 0) -> Records:
+    """Every job through ``zenav run``'s path (the whole service stack, lockstep);
+    ``verify`` is unused (these runs are the stack's)."""
     return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=reuse,
                      keep_going=True)
 
 
 def inprocess_engine(jobs: Sequence[Job], parallel: int, on_done: OnDone,
-                     reuse: bool = False) -> dict[str, Record]:
+                     reuse: bool = False, verify: int = DEFAULT_VERIFY) -> Records:
     """Every job with the in-process engine (``zenav run --engine inprocess``) in worker
-    processes; a seeded sample is then re-made through the stack and compared tick by
-    tick (:func:`zenav.batch.run_batch`)."""
+    processes; a seeded sample of ``verify`` jobs is then re-made through the stack and
+    compared tick by tick (:func:`zenav.batch.run_batch`)."""
     return run_batch(jobs, parallel, on_done, log_level="WARNING", reuse=reuse,
-                     keep_going=True, engine="inprocess", picture=False)
+                     keep_going=True, engine="inprocess", picture=False, verify=verify)
 
 
 ENGINES: dict[str, Engine] = {"stack": stack_engine, "inprocess": inprocess_engine}
@@ -208,7 +210,7 @@ def write_cases(settings: Sequence[str], cases: int, seed: int,
 
 
 def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: str,
-          jobs: int) -> None:
+          jobs: int, verify: int = DEFAULT_VERIFY) -> None:
     """Refuse bad arguments with one line naming the problem (ValueError)."""
     from zenav.services.runner import PLANNERS as KNOWN
 
@@ -226,15 +228,18 @@ def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: 
         raise ValueError(f"--cases must be >= 1 (got {cases})")
     if jobs < 1:
         raise ValueError(f"--jobs must be >= 1 (got {jobs})")
+    if verify < 0:
+        raise ValueError(f"--verify must be >= 0 (got {verify})")
 
 
 def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int = 0,
               settings: Sequence[str] = tuple(SETTINGS), jobs: int = 2, engine: str = "inprocess",
-              progress: bool = True, reuse: bool = False,
+              progress: bool = True, reuse: bool = False, verify: int = DEFAULT_VERIFY,
               echo: Callable[[str], None] = print) -> str:
     """Write the cases, run them, print and write ``crowd.md``, ``crowd.png``, ``crowd.json``.
     ``reuse``: a run whose ``run.json`` is already under ``out`` is not run again (its
-    wall time is then not the sweep's)."""
+    wall time is then not the sweep's). ``verify``: in-process runs made again through
+    the stack and compared tick by tick; the report says whether they agree."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -244,7 +249,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
         TimeRemainingColumn,
     )
 
-    check(planners, settings, cases, engine, jobs)
+    check(planners, settings, cases, engine, jobs, verify)
     out.mkdir(parents=True, exist_ok=True)
     written = write_cases(settings, cases, seed, out / "cases")
     job_list = [Job(f"{name}/{p}/{case}", path, out / "runs" / name / p / str(case), planner=p)
@@ -266,7 +271,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
             finished = sum(len(v) for v in records.values())
             bar.update(task, advance=1, description=f"{finished} done, {reached} reached")
 
-        ENGINES[engine](job_list, jobs, done, reuse)
+        batch = ENGINES[engine](job_list, jobs, done, reuse, verify)
     wall = time.monotonic() - started
     for name in settings:
         for r in records[name]:
@@ -276,12 +281,14 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
     command = (f"zenav bench crowd --cases {cases} --planners {','.join(planners)} "
                f"--seed {seed} --jobs {jobs} --engine {engine}"
                + ("" if tuple(settings) == tuple(SETTINGS) else
-                  f" --settings {','.join(settings)}") + (" --reuse" if reuse else ""))
+                  f" --settings {','.join(settings)}") + (" --reuse" if reuse else "")
+               + ("" if engine == "stack" or verify == DEFAULT_VERIFY else f" --verify {verify}"))
     parts = [f"# zenav bench crowd\n\n`{command}`\n\n"
              f"{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, {machine()}; "
              f"{len(job_list)} runs ({cases} cases x {len(planners)} planners x "
              f"{len(settings)} settings, CrowdNav test cases {seed}..{seed + cases - 1}), "
-             f"engine {engine}, {jobs} at a time, wall time {wall / 60:.1f} min\n\n"
+             f"engine {engine}{verified_note(batch)}, {jobs} at a time, "
+             f"wall time {wall / 60:.1f} min\n\n"
              "Success, collision and timeout are fractions of the runs; time to goal is "
              "the mean over the successes; discomfort is the fraction of simulator ticks "
              "with the robot within 0.2 m of a human (surface to surface).\n"]
@@ -290,7 +297,8 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
     report = "".join(parts)
     (out / "crowd.md").write_text(report)
     (out / "crowd.json").write_text(json.dumps(
-        {"command": command, "wall_s": round(wall, 1),
+        {"command": command, "wall_s": round(wall, 1), "verified": batch.verified,
+         "disagreements": batch.disagreements,
          "settings": {n: [{k: (None if isinstance(v, float) and math.isnan(v) else v)
                            for k, v in vars(r).items()} for r in rows]
                       for n, rows in results.items()},
@@ -306,7 +314,7 @@ def _command(args: argparse.Namespace) -> int:
     try:
         run_crowd(words(args.planners), args.out, cases=args.cases, seed=args.seed,
                   settings=words(args.settings), jobs=args.jobs, engine=args.engine,
-                  progress=not args.no_progress, reuse=args.reuse)
+                  progress=not args.no_progress, reuse=args.reuse, verify=args.verify)
     except ValueError as exc:
         print(f"zenav bench crowd: {exc}", file=sys.stderr)
         return 2
@@ -331,9 +339,12 @@ def add_command(kinds: Any) -> None:
                        "processes)")
     crowd.add_argument("--engine", default="inprocess",
                        help=f"how each run is made: {', '.join(ENGINES)} (default "
-                       "inprocess: the services in one process per run, three cases made "
+                       "inprocess: the services in one process per run, --verify cases made "
                        "again through the stack and compared; stack: every run through "
                        "zenav run's six processes)")
+    crowd.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
+                       help="in-process runs re-made through the stack and compared tick by "
+                       f"tick (default {DEFAULT_VERIFY})")
     crowd.add_argument("--out", type=Path, default=Path("out/bench-crowd"),
                        help="directory for the cases, runs, crowd.md, crowd.png, crowd.json")
     crowd.add_argument("--reuse", action="store_true",

@@ -23,7 +23,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from zenav.batch import DEFAULT_VERIFY, Job, Records, default_jobs, run_batch
+from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch, verified_note
 from zenav.bench.common import machine, words
 from zenav.engine import ENGINES
 from zenav.sim.generate import FAMILIES, random_scenario
@@ -237,16 +237,6 @@ def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
                    if families[f].get(p + "/n", 0) else 0.0 for p in planners]
                for f in KNOWN if f in families}
     draw_bench_chart(planners, outcomes, success, path)
-
-
-def verified_note(batch: Records) -> str:
-    """What the stack said of the in-process runs it re-made, for the report."""
-    if not batch.verified:
-        return ""
-    if batch.disagreements:
-        return (f"; {len(batch.disagreements)} of {len(batch.verified)} runs re-made through "
-                f"the stack DISAGREE")
-    return f"; {len(batch.verified)} runs re-made through the stack agree tick by tick"
 
 
 def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
