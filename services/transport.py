@@ -140,26 +140,31 @@ class Subscription:
                 self._loop.call_soon_threadsafe(self._wake)
 
     def _wake(self) -> None:
-        """On the loop: hand every buffered sample to the consumer, oldest first, or wake
-        the task waiting in :meth:`get`."""
+        """On the loop: hand the oldest buffered sample to the consumer, and come back on
+        the loop's next turn while more wait (so that a service's inputs take turns, one
+        sample each, as their samples came, and a burst on one input does not run ahead
+        of another's: perception's scan and the odometry it waits for); or wake the task
+        waiting in :meth:`get`."""
         if self._consumer is None:
             with self._lock:
                 self._wake_pending = False
             self._ready.set()
             return
-        while True:
+        with self._lock:
+            if self._closed or self._paused or not self._buffer:
+                self._wake_pending = False
+                return
+            key, payload = self._buffer.popleft()
+        try:
+            self._consumer(key, payload)
+        finally:  # a consumer that raises: the loop reports it; the samples after it come
             with self._lock:
-                if self._closed or self._paused or not self._buffer:
-                    self._wake_pending = False
-                    return
-                key, payload = self._buffer.popleft()
-            try:
-                self._consumer(key, payload)
-            except BaseException:  # the loop reports it; the samples after it still come
-                with self._lock:
-                    self._wake_pending = False
-                self._schedule()
-                raise
+                more = (self._consumer is not None and not self._closed and not self._paused
+                        and bool(self._buffer))
+                self._wake_pending = more
+            if more:
+                assert self._loop is not None  # set with the consumer
+                self._loop.call_soon(self._wake)
 
     def consume(self, consumer: Callable[[str, bytes], None]) -> None:
         """From now on, call ``consumer(key, payload)`` on the loop for each sample, oldest

@@ -44,11 +44,13 @@ async def test_samples_offered_from_another_thread_are_bounded_newest_wins() -> 
         await asyncio.sleep(0)
     assert seen == [b"4", b"5"]
     assert sub.dropped == 3
-    assert wakes == 1  # one wake-up for the burst, not one per sample
+    # One wake-up from the other thread for the burst (not one per sample), then one turn
+    # of the loop per sample.
+    assert wakes == 2
     _offer_from_a_thread(sub, [b"6"])
     for _ in range(3):
         await asyncio.sleep(0)
-    assert seen == [b"4", b"5", b"6"] and wakes == 2 and sub.dropped == 3
+    assert seen == [b"4", b"5", b"6"] and wakes == 3 and sub.dropped == 3
 
 
 async def test_a_paused_consumer_gets_the_newest_samples_on_resume() -> None:
@@ -61,8 +63,26 @@ async def test_a_paused_consumer_gets_the_newest_samples_on_resume() -> None:
     await asyncio.sleep(0)
     assert seen == [] and sub.pending() == 2
     sub.resume()
-    await asyncio.sleep(0)
+    for _ in range(3):
+        await asyncio.sleep(0)
     assert seen == [b"2", b"3"] and sub.dropped == 1
+
+
+async def test_inputs_take_turns_a_sample_each_as_their_samples_came() -> None:
+    """Two inputs with samples waiting (the loop was busy): handled a, b, a, b as they came,
+    not all of one input first (a scan that waits for its odometry must get it before the
+    next scan comes)."""
+    loop = asyncio.get_running_loop()
+    scans, odometry = Subscription("scan", 4, loop), Subscription("odom", 4, loop)
+    handled: list[bytes] = []
+    scans.consume(lambda key, payload: handled.append(payload))
+    odometry.consume(lambda key, payload: handled.append(payload))
+    for sub, payload in ((scans, b"scan 0.2"), (odometry, b"odom 0.2"),
+                         (scans, b"scan 0.3"), (odometry, b"odom 0.3")):
+        _offer_from_a_thread(sub, [payload])
+    for _ in range(6):
+        await asyncio.sleep(0)
+    assert handled == [b"scan 0.2", b"odom 0.2", b"scan 0.3", b"odom 0.3"]
 
 
 async def test_get_still_serves_a_task_when_samples_come_from_another_thread() -> None:
