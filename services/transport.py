@@ -80,8 +80,9 @@ class Subscription:
     less per message). Samples come in with ``push`` on the loop's thread (the in-memory
     bus), or with ``offer`` from any thread (Zenoh's): the sample goes into the buffer
     there and then, and the loop is woken once for all the samples that come before it
-    gets to them. Either way at most ``depth`` samples wait; a newer one drops the oldest
-    and counts it in ``dropped``.
+    gets to them; it then hands them over one per turn (:meth:`_wake`). Either way at
+    most ``depth`` samples wait; a newer one drops the oldest and counts it in
+    ``dropped``.
     """
 
     def __init__(self, key_expr: str, depth: int,
