@@ -85,6 +85,10 @@ class Service:
         if pose is not None:
             self.process(scan, pose)
         elif self.history.newest is None or scan.stamp > self.history.newest:
+            if self.waiting is not None:  # one scan waits at most: the newer one wins
+                self.node.reject(self.node.keys.of(keys.SCAN), "superseded",
+                                 f"scan of t={self.waiting.stamp} replaced by t={scan.stamp} "
+                                 "before its odometry came")
             self.waiting = scan  # its odometry is still on the way
         else:
             self.node.reject(
