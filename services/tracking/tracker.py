@@ -268,6 +268,7 @@ class Tracker:
         self._tracks: list[_State] = []
         self._next_id = 1
         self._last_stamp: float | None = None
+        self._lost: list[_State] = []  # movers dropped lately, for ``reacquire`` s
         # chains to compare with: (stamp, Eq. 5 centres, grid boxes)
         self._history: deque[Chain] = deque()
 
@@ -311,7 +312,7 @@ class Tracker:
                 fresh.add(len(self._tracks))
                 members[len(self._tracks)] = [c]
                 meas[len(self._tracks)] = m
-                self._tracks.append(self._new_state(m, stamp))
+                self._tracks.append(self._reacquired(m, stamp) or self._new_state(m, stamp))
 
         # Eqs. 11-14 against the chain compared with: xi, varsigma_max, delta (cells).
         order = sorted(meas)
@@ -400,6 +401,12 @@ class Tracker:
                 and stamp - t.last_seen <= p.memory and not self._in_view(t, pose))
         ]
         out = [self._output(self._tracks[ti], dt, ti in visible and ti not in hold) for ti in live]
+        if p.reacquire > 0.0:
+            kept = set(live)
+            self._lost = [t for t in self._lost if stamp - t.last_seen <= p.reacquire]
+            self._lost += [t for ti, t in enumerate(self._tracks)
+                           if ti not in kept and t.kind == "dynamic"
+                           and math.hypot(t.vx, t.vy) >= p.static_speed]
         self._tracks = [self._tracks[ti] for ti in live]
         out.sort(key=lambda tr: tr.id)
         return out
@@ -626,6 +633,32 @@ class Tracker:
             age=1, last_seen=stamp, merged_since=None, born=stamp,
         )  # fmt: skip
         self._next_id += 1
+        return t
+
+    def _reacquired(self, m: _Measurement, stamp: float) -> _State | None:
+        """The lost mover that ``m`` is seen again, if any: the nearest whose prediction
+        from where it was last seen, at its velocity then, lies within both radii plus
+        half the way it walked meanwhile (slack for a turn or a change of pace). It comes
+        back where it is measured, with its id, velocity and type, and counts as moving
+        now: it was found where its motion took it."""
+        best: tuple[float, int] | None = None
+        for i, t in enumerate(self._lost):
+            age = stamp - t.last_seen
+            px, py = t.x + t.vx * age, t.y + t.vy * age
+            gap = math.hypot(m.point[0] - px, m.point[1] - py)
+            if (gap <= t.radius + m.radius + 0.5 * math.hypot(t.vx, t.vy) * age
+                    and (best is None or gap < best[0])):
+                best = (gap, i)
+        if best is None:
+            return None
+        t = self._lost.pop(best[1])
+        r = self.params.partial_meas_std if m.partial else self.params.meas_std
+        t.x, t.y = m.point
+        t.p00, t.p01 = r * r, 0.0
+        t.centre, t.radius, t.box, t.area = m.centre, m.radius, m.box, m.area
+        t.partial, t.n_parts = m.partial, m.n_parts
+        t.last_seen = t.last_moved = t.born = stamp
+        t.merged_since = None
         return t
 
     def _predict(self, t: _State, dt: float) -> None:
