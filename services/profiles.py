@@ -37,6 +37,7 @@ PROFILES: dict[str, dict[str, dict[str, Any]]] = {
             "method": "paper",  # the decision tree types, Eq. 15 moves
             "compare_dt": PAPER_COMPARE_PERIOD,  # T (paper silent), see above
             "memory": 0.0,  # the paper keeps no obstacle it cannot see
+            "reacquire": 0.0,  # ... and calls every obstacle it sees again new
         },
         "planner": {
             "threats_per_cycle": "one",  # Algorithm 1: the first threat, then break
