@@ -20,6 +20,7 @@ import yaml
 from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
+from zenav.services.inputs import AliasError, clipped, safe_load, shown, yaml_problem
 from zenav.services.transport import TransportConfig
 
 P = TypeVar("P", bound=BaseModel)
@@ -48,9 +49,11 @@ def read_yaml(path: Path) -> dict[str, Any]:
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
     try:
-        data = yaml.safe_load(text)
+        data = safe_load(text)
+    except AliasError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({exc})") from None
+        raise ConfigError(f"{path}: not valid YAML ({yaml_problem(exc)})") from None
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -62,9 +65,11 @@ def parse_assignment(text: str) -> tuple[list[str], Any]:
     """``a.b=1.5`` -> (["a", "b"], 1.5); the value is read as YAML."""
     name, sep, raw = text.partition("=")
     if not sep or not name.strip():
-        raise ConfigError(f"--set {text!r}: expected NAME=VALUE")
+        raise ConfigError(f"--set {shown(text)}: expected NAME=VALUE")
     try:
-        value = yaml.safe_load(raw)
+        value = safe_load(raw)
+    except AliasError as exc:
+        raise ConfigError(f"--set {shown(text)}: {exc}") from None
     except yaml.YAMLError:
         value = raw
     return name.strip().split("."), value
@@ -82,7 +87,7 @@ def _merge(base: dict[str, Any], update: dict[str, Any]) -> dict[str, Any]:
 
 def format_error(source: str, error: ErrorDetails) -> str:
     where = ".".join(str(p) for p in error["loc"]) or "(top level)"
-    got = f" (got {error['input']!r})" if error["type"] != "missing" else ""
+    got = f" (got {shown(error['input'])})" if error["type"] != "missing" else ""
     return f"{source}: {where}: {error['msg']}{got}"
 
 
@@ -108,7 +113,7 @@ def assignment_layer(text: str) -> Layer:
     nested: dict[str, Any] = {path_parts[-1]: value}
     for part in reversed(path_parts[:-1]):
         nested = {part: nested}
-    return Layer("--set", f"--set {text}", nested)
+    return Layer("--set", f"--set {clipped(text)}", nested)
 
 
 @dataclass(frozen=True)
@@ -140,9 +145,9 @@ def resolve(model: type[P], layers: list[Layer]) -> tuple[P, list[Setting]]:
             source = set_by[first].source if first in set_by else everyone
             lines.append(format_error(source, error))
         raise ConfigError("\n".join(lines)) from None
-    shown = params.model_dump(mode="json")
+    dumped = params.model_dump(mode="json")
     settings = [
-        Setting(name, shown[name], set_by[name].origin if name in set_by else "default",
+        Setting(name, dumped[name], set_by[name].origin if name in set_by else "default",
                 set_by[name].source if name in set_by else "code", info.description)
         for name, info in model.model_fields.items()
     ]

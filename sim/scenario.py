@@ -27,6 +27,8 @@ from pydantic import (
     model_validator,
 )
 
+from zenav.services.inputs import AliasError, BoundedLoader, safe_load, shown, yaml_problem
+
 __all__ = [
     "LaserSpec",
     "ObstacleSpec",
@@ -377,8 +379,9 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
 # --- loading -------------------------------------------------------------------------
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader that rejects duplicate keys and reads ``1e-3`` as a float (YAML 1.2)."""
+class _Loader(BoundedLoader):
+    """SafeLoader that rejects duplicate keys, reads ``1e-3`` as a float (YAML 1.2) and
+    refuses aliases that expand too far (:class:`BoundedLoader`)."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
         seen: set[object] = set()
@@ -409,9 +412,11 @@ def load_scenario(path: str | Path) -> Scenario:
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{source}: cannot read file ({exc})") from None
     try:
-        data = yaml.load(text, Loader=_Loader)  # _Loader is a SafeLoader
+        data = safe_load(text, _Loader)
+    except AliasError as exc:
+        raise ScenarioError(f"{source}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ScenarioError(f"{source}: YAML syntax error: {_yaml_problem(exc)}") from None
+        raise ScenarioError(f"{source}: YAML syntax error: {yaml_problem(exc)}") from None
     return parse_scenario(data, source)
 
 
@@ -430,13 +435,6 @@ def parse_scenario(data: object, source: str) -> Scenario:
         raise ScenarioError("\n".join(lines)) from None
 
 
-def _yaml_problem(exc: yaml.YAMLError) -> str:
-    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
-        mark = exc.problem_mark
-        return f"{exc.problem} (line {mark.line + 1}, column {mark.column + 1})"
-    return str(exc)
-
-
 def _format_loc(loc: Iterable[str | int]) -> str:
     text = ""
     for part in loc:
@@ -448,11 +446,12 @@ def _format_loc(loc: Iterable[str | int]) -> str:
 
 
 def _show(value: object) -> str:
+    """A value as an error line quotes it: short (:func:`shown`), floats as ``%g``."""
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, tuple):
         value = list(value)
-    return repr(value)
+    return shown(value)
 
 
 def _problems(errors: Iterable[Any]) -> list[tuple[str, str]]:
