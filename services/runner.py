@@ -35,6 +35,7 @@ from zenav.services.config import (
     loopback_mesh,
     read_yaml,
 )
+from zenav.services.inputs import OneLineParser
 from zenav.services.transport import Bus, TransportConfig, ZenohBus
 
 if TYPE_CHECKING:
@@ -47,10 +48,13 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 class Where(NamedTuple):
-    """Where a service's parameter model and its service class are ("module:Class")."""
+    """Where a service's parameter model and its service class are ("module:Class"), and
+    the function that checks its parameters beyond the model before anything starts
+    (``check(params)`` raising ValueError, e.g. the simulator's scenario file), if any."""
 
     params: str
     service: str
+    check: str | None = None
 
 
 PLANNERS: dict[str, Where] = {
@@ -68,7 +72,8 @@ PLANNERS: dict[str, Where] = {
 as the paper's planner, and runs as the ``planner`` service (``--planner NAME``)."""
 
 SERVICES: dict[str, Where] = {
-    "simulator": Where("zenav.sim.params:Params", "zenav.sim.node:Service"),
+    "simulator": Where("zenav.sim.params:Params", "zenav.sim.node:Service",
+                       "zenav.sim.params:check"),
     "laser_driver": Where("zenav.services.laser_driver.params:Params",
                           "zenav.services.laser_driver.node:Service"),
     "perception": Where("zenav.services.perception.params:PerceptionParams",
@@ -111,6 +116,14 @@ def service_params(name: str, planner: str = "paper") -> type[BaseModel]:
     return model
 
 
+def check_params(name: str, params: BaseModel, planner: str = "paper") -> None:
+    """What the service would refuse at start-up, found now: ValueError (ConfigError,
+    ScenarioError) saying why, before a session is opened or a process told it runs."""
+    where = _where(name, planner)
+    if where.check is not None:
+        _load(where.check)(params)
+
+
 def implementation(name: str, planner: str = "paper") -> Implementation:
     """The parameter model and the service class of a service; ConfigError if none."""
     where = _where(name, planner)
@@ -129,10 +142,36 @@ def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--connect", action="append", default=[], metavar="ENDPOINT")
     group.add_argument(
         "--base-port",
-        type=int,
+        type=base_port,
         default=DEFAULT_BASE_PORT,
         help="first port of the loopback mesh used when no endpoint is given",
     )
+
+
+def base_port(text: str) -> int:
+    """``--base-port``: the first of the mesh's ports, all of which must be TCP ports."""
+    last = 65535 - len(SERVICE_ORDER)
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number (got {text!r})") from None
+    if not 1 <= port <= last:
+        raise argparse.ArgumentTypeError(
+            f"must be in 1..{last}: the mesh takes {len(SERVICE_ORDER) + 1} ports from it "
+            f"(got {port})")
+    return port
+
+
+LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
+
+
+def add_log_level_argument(parser: argparse.ArgumentParser, what: str = "log level") -> None:
+    """``--log-level``, one of :data:`LOG_LEVELS` in any case, checked by argparse: a
+    wrong one is a one-line usage error before anything starts (every command that
+    starts services or joins the bus shares it)."""
+    parser.add_argument("--log-level", type=str.upper, choices=LOG_LEVELS, default="INFO",
+                        metavar="LEVEL", help=f"{what}: {', '.join(LOG_LEVELS)} "
+                                              "(default INFO; any case)")
 
 
 def transport_from_args(args: argparse.Namespace, service: str | None) -> TransportConfig:
@@ -161,6 +200,16 @@ def add_standby_argument(parser: argparse.ArgumentParser) -> None:
 _HELD: list[int] = []
 """Descriptors of the standby locks this process holds (kept open for its whole life: the
 kernel releases the lock when the process ends, however it ends)."""
+
+
+def check_lock(lock: Path) -> None:
+    """ConfigError unless ``lock`` can be opened (its folder created) as a standby lock."""
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        os.close(os.open(lock, os.O_RDWR | os.O_CREAT, 0o644))
+    except OSError as exc:
+        raise ConfigError(f"--standby-lock {lock}: cannot open it as a lock file "
+                          f"({exc.strerror or exc})") from None
 
 
 def take_over(lock: Path, name: str) -> None:
@@ -302,12 +351,13 @@ async def serve(name: str, bus: Bus, keys: Keys, params: Any, planner: str = "pa
 
 
 def main(name: str, argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog=f"zenav service {name}")
+    parser = OneLineParser(prog=f"zenav service {name}",
+                           epilog=f"Its parameters, their defaults and units: zenav params {name}")
     parser.add_argument("--config", type=Path, action="append", default=[], metavar="FILE",
                         help="YAML parameter file (repeatable; later files win)")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override one parameter (dotted names for nested ones)")
-    parser.add_argument("--log-level", default="INFO")
+    add_log_level_argument(parser)
     if name == "planner":
         parser.add_argument("--planner", default="paper",
                             help=f"implementation: {', '.join(PLANNERS)} (default paper)")
@@ -320,8 +370,11 @@ def main(name: str, argv: list[str] | None = None) -> int:
     try:
         planner = getattr(args, "planner", "paper")
         params = load_params(service_params(name, planner), args.config, args.set)
+        check_params(name, params, planner)
         keys = Keys(check_robot_id(args.robot_id))
         transport = transport_from_args(args, name)
+        if args.standby_lock is not None:
+            check_lock(args.standby_lock)
     except (ConfigError, ValueError) as exc:
         for line in str(exc).splitlines():  # one line per problem, each naming the service
             print(f"zenav {name}: {line}", file=sys.stderr)

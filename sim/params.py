@@ -85,3 +85,13 @@ class Params(BaseModel):
             max_neighbors=self.crowd_max_neighbors, time_horizon=self.crowd_time_horizon,
             time_horizon_obst=self.crowd_time_horizon_obst,
             radius_margin=self.crowd_radius_margin, slow_within=self.crowd_slow_within)
+
+
+def check(params: Params) -> None:
+    """What the simulator service would refuse at start-up, before it starts: no
+    scenario, or one that does not load (ValueError; ScenarioError names file and field)."""
+    from zenav.sim.scenario import load_scenario
+
+    if params.scenario is None:
+        raise ValueError("the simulator needs a scenario: --set scenario=FILE")
+    load_scenario(params.scenario)

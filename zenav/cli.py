@@ -20,9 +20,9 @@ benchmarks repeat, and that second was a fifth of a whole run."""
 
 def build_light_parser(command: str) -> argparse.ArgumentParser:
     """The parser of one of the :data:`LIGHT` commands only."""
-    parser = argparse.ArgumentParser(
-        prog="zenav", description="Mobile-robot navigation as Zenoh services."
-    )
+    from zenav.services.inputs import OneLineParser
+
+    parser = OneLineParser(prog="zenav", description="Mobile-robot navigation as Zenoh services.")
     sub = parser.add_subparsers(dest="command", required=True)
     if command == "router":
         from zenav.deploy import router
@@ -43,10 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     from zenav.deploy import router
     from zenav.foxglove import live as foxglove_live
     from zenav.monitor import command as monitor
+    from zenav.services.inputs import OneLineParser
 
-    parser = argparse.ArgumentParser(
-        prog="zenav", description="Mobile-robot navigation as Zenoh services."
-    )
+    parser = OneLineParser(prog="zenav", description="Mobile-robot navigation as Zenoh services.")
     sub = parser.add_subparsers(dest="command", required=True)
     stackcmd.add_commands(sub)  # run, service, schemas
 
@@ -71,18 +70,25 @@ def main(argv: list[str] | None = None) -> int:
         code = _main(argv)
     except KeyboardInterrupt:
         code = 130
-    from zenav.services.runner import closed_cleanly
-    from zenav.services.runner import still_opening as service_opening
-    from zenav.tooling import still_opening
-
     # Stopped while connecting, the interpreter's teardown stalls for seconds in Zenoh's;
     # after a service's clean stop it has nothing left to do but free memory.
-    if still_opening() or service_opening() or closed_cleanly():
+    if _nothing_left_but_teardown():
         logging.shutdown()
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
     return code
+
+
+def _nothing_left_but_teardown() -> bool:
+    """Whether a session is still being opened by a thread no one waits for, or this
+    process's service closed everything cleanly: then ``os._exit`` ends it. Only modules
+    the command loaded are asked (importing one now would be time for a Ctrl-C to land
+    in, outside any handler)."""
+    runner = sys.modules.get("zenav.services.runner")
+    tooling = sys.modules.get("zenav.tooling")
+    return bool((tooling is not None and tooling.still_opening())
+                or (runner is not None and (runner.still_opening() or runner.closed_cleanly())))
 
 
 def _main(argv: list[str] | None) -> int:
@@ -100,7 +106,9 @@ def _main(argv: list[str] | None) -> int:
 
 def _out_problem(args: argparse.Namespace) -> str | None:
     """Every command's ``--out`` folder is checked before it starts work: a bad one (an
-    existing file, a folder under a file, /proc or /sys) is one line, not a traceback."""
+    existing file, a folder under a file, /proc or /sys) is one line, not a traceback.
+    Nothing is created here: each command makes its folder once the rest of its input
+    is known good (a refused scenario leaves no empty folder behind)."""
     from pathlib import Path
 
     from zenav.writable import PathError, check_output_dir
@@ -109,7 +117,7 @@ def _out_problem(args: argparse.Namespace) -> str | None:
     if not isinstance(out, Path):
         return None
     try:
-        check_output_dir(out)
+        check_output_dir(out, create=False)
     except PathError as exc:
         return str(exc)
     return None

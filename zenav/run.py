@@ -36,6 +36,7 @@ from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
 from zenav.services.runner import PLANNERS, service_params
 from zenav.services.transport import Latest, Subscription, ZenohBus
 from zenav.sim.scenario import load_scenario
+from zenav.writable import check_output_dir
 
 
 class RunError(RuntimeError):
@@ -299,7 +300,7 @@ def run_scenario(
     check_overrides(params, overrides or [], planner, f"scenario {scenario_path}")
     for text in overrides or []:
         apply_override(params, text)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    check_output_dir(out_dir)  # made only now, the input known good (PathError if it cannot)
     started = time.monotonic()
     codes: dict[str, int] = {}
     heard = Heard()

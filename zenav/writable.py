@@ -35,13 +35,20 @@ def _make_folder(path: Path, shown: Path) -> None:
         raise PathError(f"{shown}: the folder is not writable")
 
 
-def check_output_dir(path: Path) -> Path:
+def check_output_dir(path: Path, create: bool = True) -> Path:
     """Make ``path`` a writable folder (creating it and its parents); PathError if it
-    cannot be one."""
+    cannot be one. ``create=False``: only check that it could be made, creating nothing
+    (a command whose other input may still be refused)."""
     absolute = _common_checks(path)
     if absolute.exists() and not absolute.is_dir():
         raise PathError(f"{path}: exists and is not a folder")
-    _make_folder(absolute, path)
+    if create:
+        _make_folder(absolute, path)
+        return path
+    existing = next(p for p in (absolute, *absolute.parents) if p.exists())
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "folder is" if existing == absolute else f"folder {existing} is"
+        raise PathError(f"{path}: the {what} not writable")
     return path
 
 

@@ -21,6 +21,7 @@ import zenoh
 
 from zenav.services.config import ConfigError
 from zenav.services.runner import (
+    add_log_level_argument,
     add_standby_argument,
     add_transport_arguments,
     setup_logging,
@@ -98,7 +99,7 @@ def main(args: argparse.Namespace) -> int:
 def add_command(sub: Any) -> None:
     router = sub.add_parser("router", help="run a Zenoh router (the robot's, for off-board "
                             "services and monitors)")
-    router.add_argument("--log-level", default="INFO")
+    add_log_level_argument(router)
     add_transport_arguments(router)
     add_standby_argument(router)
     router.set_defaults(func=main)
