@@ -58,6 +58,18 @@ def write_params(directory: Path, service: str, params: Mapping[str, Any]) -> Pa
     return path
 
 
+def ended(code: int) -> str:
+    """How a process ended, from its ``Popen.returncode``: a negative one is the signal
+    that killed it ("was killed by signal 9 (SIGKILL)"), not a status it chose."""
+    if code >= 0:
+        return f"exited with status {code}"
+    try:
+        name = f" ({signal.Signals(-code).name})"
+    except ValueError:
+        name = ""
+    return f"was killed by signal {-code}{name}"
+
+
 def last_line(path: Path) -> str:
     try:
         lines = [line for line in path.read_text(errors="replace").splitlines() if line.strip()]
@@ -116,7 +128,7 @@ class Stack:
             code = proc.poll()
             if code is not None:
                 why = last_line(self.log_path(service))
-                return f"service {service} exited with status {code}" + (f": {why}" if why else "")
+                return f"service {service} {ended(code)}" + (f": {why}" if why else "")
         return None
 
     def stop(self, grace: float = 3.0) -> dict[str, int]:
