@@ -24,6 +24,7 @@ import os
 import random
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -86,18 +87,22 @@ def error_record(job: Job, error: str) -> dict[str, Any]:
 
 def run_job(job: Job, *, log_level: str = "INFO", reuse: bool = False,
             keep_going: bool = False, engine: str = "stack",
-            picture: bool = True) -> dict[str, Any]:
+            picture: bool = True, stop: threading.Event | None = None) -> dict[str, Any]:
     """One run; its record. ``reuse``: a ``run.json`` already in ``job.out`` is the record.
     ``keep_going``: a failed run gives an :func:`error_record` instead of raising.
-    ``picture``: draw ``run.png`` too."""
+    ``picture``: draw ``run.png`` too. ``stop`` (stack): set, the run ends at once with
+    KeyboardInterrupt, its processes stopped (see :func:`zenav.run.run_scenario`)."""
     record_path = job.out / "run.json"
     if reuse and record_path.exists():
         reused: dict[str, Any] = json.loads(record_path.read_text())
         return reused
     try:
         # run_scenario draws run.png itself: it has the planner's last map to draw.
+        if stop is not None and stop.is_set():
+            raise KeyboardInterrupt  # the batch is stopping: start no more runs
         record = run_scenario(job.scenario, job.out, planner=job.planner, log_level=log_level,
-                              picture=picture, profile=job.profile, engine=engine)
+                              picture=picture, profile=job.profile, engine=engine,
+                              stop=stop)
     except Exception as exc:
         if not keep_going:
             raise
@@ -120,6 +125,24 @@ def stop_workers(pool: ProcessPoolExecutor) -> None:
         process.join(timeout=1.0)
 
 
+def _run_threads(jobs: list[Job], parallel: int, options: dict[str, Any],
+                 done: Callable[[Job, dict[str, Any]], None]) -> None:
+    """Stack jobs, each in a thread of its own (each run is its own processes). Ctrl-C
+    (or a failed job) sets the runs' ``stop``: the runs under way end within a tenth of
+    a second, their stacks torn down, and the queued ones never start."""
+    stop = threading.Event()
+    threads = ThreadPoolExecutor(max(1, parallel))
+    try:
+        futures = {threads.submit(run_job, job, stop=stop, **options): job for job in jobs}
+        for future in as_completed(futures):
+            done(futures[future], future.result())
+    except BaseException:
+        stop.set()
+        threads.shutdown(wait=True, cancel_futures=True)
+        raise
+    threads.shutdown(wait=True)
+
+
 def sample(jobs: list[Job], count: int, seed: int = 0) -> list[Job]:
     """``count`` of ``jobs`` chosen by ``seed`` (the same jobs for the same list)."""
     return random.Random(seed).sample(jobs, min(count, len(jobs)))
@@ -133,11 +156,15 @@ def verify_with_stack(jobs: list[Job], records: dict[str, dict[str, Any]], paral
     disagreements: list[str] = []
     candidates = [job for job in jobs if records.get(job.key, {}).get("outcome") != "error"]
 
+    stop = threading.Event()  # Ctrl-C: the re-runs under way end, their stacks stopped
+
     def again(job: Job) -> tuple[Job, dict[str, Any]]:
         redo = dataclasses.replace(job, out=job.out / "stack-check")
-        return job, run_job(redo, log_level=log_level, keep_going=True, picture=False)
+        return job, run_job(redo, log_level=log_level, keep_going=True, picture=False,
+                            stop=stop)
 
-    with ThreadPoolExecutor(max(1, parallel)) as pool:
+    pool = ThreadPoolExecutor(max(1, parallel))
+    try:
         for job, stack in pool.map(again, candidates):
             checked.append(job.key)
             if stack["outcome"] == "error":
@@ -146,6 +173,11 @@ def verify_with_stack(jobs: list[Job], records: dict[str, dict[str, Any]], paral
             where = first_difference(stack, records[job.key])
             if where is not None:
                 disagreements.append(f"{job.key}: {where}")
+    except BaseException:
+        stop.set()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
     return checked, disagreements
 
 
@@ -171,10 +203,7 @@ def run_batch(jobs: Iterable[Job], parallel: int,
             on_done(job, record)
 
     if engine == "stack":
-        with ThreadPoolExecutor(max(1, parallel)) as threads:
-            futures = {threads.submit(run_job, job, **options): job for job in job_list}
-            for future in as_completed(futures):
-                done(futures[future], future.result())
+        _run_threads(job_list, parallel, options, done)
         return records
     context = multiprocessing.get_context("forkserver" if sys.platform != "win32" else "spawn")
     pool = ProcessPoolExecutor(max(1, parallel), mp_context=context, initializer=_worker_start)

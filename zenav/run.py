@@ -12,9 +12,13 @@ import asyncio
 import contextlib
 import json
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 from zenav.engine import PATHS_KEPT, add_path
@@ -123,11 +127,25 @@ class Heard:
 
 
 async def _collect(stack: Stack, progress_timeout: float, record: Path | None = None,
-                   heard: Heard | None = None) -> tuple[RunResult, list[PlannerEvent]]:
+                   heard: Heard | None = None, stop: threading.Event | None = None
+                   ) -> tuple[RunResult, list[PlannerEvent]]:
     """Join the stack, gather events until the simulator's result arrives (and the
     newest path and map into ``heard``); with ``record``, write every message of the run
-    there as MCAP (zenav's msgpack channels and the Foxglove ones)."""
+    there as MCAP (zenav's msgpack channels and the Foxglove ones). ``stop`` set (Ctrl-C,
+    or a batch being stopped) ends it within a tenth of a second with KeyboardInterrupt."""
     heard = heard if heard is not None else Heard()
+    stop = stop if stop is not None else threading.Event()
+
+    def check() -> None:
+        if stop.is_set():
+            raise KeyboardInterrupt
+        failure = stack.failure()
+        if failure:
+            # a service stopped by the same Ctrl-C is not a failure of the run
+            if stop.is_set():
+                raise KeyboardInterrupt
+            raise RunError(failure)
+
     k = Keys(stack.robot_id)
     bus = ZenohBus(stack.transport(driver=True), asyncio.get_running_loop())
     recording = _Recording(bus, record, stack.robot_id) if record is not None else None
@@ -152,9 +170,7 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         deadline = time.monotonic() + progress_timeout
         arrived = 0
         while not everyone.is_set():
-            failure = stack.failure()
-            if failure:
-                raise RunError(failure)
+            check()
             if len(alive) > arrived:
                 arrived, deadline = len(alive), time.monotonic() + progress_timeout
             if time.monotonic() > deadline:
@@ -179,9 +195,7 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         sim_time = -1.0
         result: RunResult | None = None
         while result is None:
-            failure = stack.failure()
-            if failure:
-                raise RunError(failure)
+            check()
             try:
                 _, payload = await asyncio.wait_for(results.get(), timeout=0.1)
                 result = decode(payload, RunResult, k.of(keys.RESULT), keys.RESULT.max_bytes)
@@ -204,6 +218,7 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         await _take_paths_and_map(k, paths, maps, heard)  # those sent before the result
         # The planner keeps every event it made; asking for them all does not depend on
         # this process having been subscribed before the first one.
+        check()
         history = await bus.query(k.of(keys.EVENT_HISTORY), timeout=5.0)
         payloads = [payload for _, payload in history]
         while events_sub.pending():
@@ -258,6 +273,32 @@ class _Recording:
         self.stream.close()
 
 
+STOP_GRACE_INTERRUPTED = 1.5
+"""Wall s a service stopped by Ctrl-C has to end before it is killed (the command is to
+end within 3 s of it)."""
+
+
+@contextlib.contextmanager
+def _interrupt_sets(stop: threading.Event) -> Iterator[None]:
+    """In the main thread: SIGINT sets ``stop`` and raises KeyboardInterrupt (once; a
+    second one while the stack stops is ignored, so the stop is not cut short). Elsewhere
+    (a batch's worker thread) nothing: the batch sets ``stop`` itself."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_sigint(signum: int, frame: FrameType | None) -> None:
+        if not stop.is_set():
+            stop.set()
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def run_scenario(
     scenario_path: Path,
     out_dir: Path,
@@ -270,6 +311,7 @@ def run_scenario(
     mcap: bool = False,
     profile: str = DEFAULT_PROFILE,
     engine: str = "stack",
+    stop: threading.Event | None = None,
 ) -> dict[str, Any]:
     """Run one scenario; write run.json and run.png; the record.
 
@@ -281,7 +323,10 @@ def run_scenario(
     ``mcap`` (stack only): also ``run.mcap``, every message of the run, openable in
     Foxglove.
     ``profile``: the named set of parameter overrides (``zenav.services.profiles``) laid
-    over the defaults, under the scenario's values and ``overrides``."""
+    over the defaults, under the scenario's values and ``overrides``.
+    ``stop`` (stack only): set from another thread, the run ends within a tenth of a
+    second, its processes stopped, with KeyboardInterrupt; in the main thread Ctrl-C
+    sets it (the services stopped by the same Ctrl-C are then not a failure)."""
     scenario = load_scenario(scenario_path)  # raises ScenarioError naming file and field
     if planner not in PLANNERS:
         raise ConfigError(f"--planner {planner!r}: no such planner; choose from "
@@ -315,13 +360,16 @@ def run_scenario(
         result, events = ran.result, ran.events
         heard.path, heard.occupancy, heard.paths = ran.path, ran.occupancy, ran.paths
     else:
+        stop = stop if stop is not None else threading.Event()
         stack = Stack(out_dir=out_dir, params=params, log_level=log_level, planner=planner)
-        stack.start()
-        try:
-            result, events = asyncio.run(_collect(stack, progress_timeout,
-                                                  out_dir / "run.mcap" if mcap else None, heard))
-        finally:
-            codes = stack.stop()
+        with _interrupt_sets(stop):
+            try:
+                stack.start()
+                result, events = asyncio.run(_collect(
+                    stack, progress_timeout, out_dir / "run.mcap" if mcap else None, heard,
+                    stop))
+            finally:  # stopped however the run ended: no service outlives it
+                codes = stack.stop(grace=STOP_GRACE_INTERRUPTED if stop.is_set() else 3.0)
     record = make_record(result, events, planner)
     record["wall_time"] = round(time.monotonic() - started, 3)
     record["seed"] = scenario.seed
