@@ -11,6 +11,7 @@ the file, the field and the problem.
 
 from __future__ import annotations
 
+import math
 import textwrap
 from dataclasses import dataclass
 from pathlib import Path
@@ -85,10 +86,43 @@ def _merge(base: dict[str, Any], update: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
+FINITE = "must be a finite number"
+"""What a parameter given as inf, -inf, nan or a number beyond a float (1e400) is told, as
+the scenario loader says it."""
+
+
+def non_finite(value: object) -> bool:
+    """Whether ``value`` is, or is text read as, a float that is not finite."""
+    if isinstance(value, float):
+        return not math.isfinite(value)
+    if isinstance(value, str):
+        try:
+            return not math.isfinite(float(value))
+        except ValueError:
+            return False
+    return False
+
+
+def _non_finite_leaves(value: object, loc: tuple[str | int, ...]
+                       ) -> list[tuple[tuple[str | int, ...], float]]:
+    if isinstance(value, float) and not math.isfinite(value):
+        return [(loc, value)]
+    if isinstance(value, dict):
+        return [leaf for key, item in value.items()
+                for leaf in _non_finite_leaves(item, (*loc, str(key)))]
+    if isinstance(value, list | tuple):
+        return [leaf for i, item in enumerate(value)
+                for leaf in _non_finite_leaves(item, (*loc, i))]
+    return []
+
+
 def format_error(source: str, error: ErrorDetails) -> str:
     where = ".".join(str(p) for p in error["loc"]) or "(top level)"
     got = f" (got {shown(error['input'])})" if error["type"] != "missing" else ""
-    return f"{source}: {where}: {error['msg']}{got}"
+    message = error["msg"]
+    if error["type"] not in ("missing", "extra_forbidden") and non_finite(error["input"]):
+        message = FINITE  # nan is not "not greater than 0": it is no number at all
+    return f"{source}: {where}: {message}{got}"
 
 
 Origin = Literal["default", "profile", "scenario", "file", "--set"]
@@ -145,6 +179,13 @@ def resolve(model: type[P], layers: list[Layer]) -> tuple[P, list[Setting]]:
             source = set_by[first].source if first in set_by else everyone
             lines.append(format_error(source, error))
         raise ConfigError("\n".join(lines)) from None
+    # pydantic reads "inf" and "1e400" as floats; no parameter of ours may be infinite
+    infinite = [format_error(set_by[str(loc[0])].source if str(loc[0]) in set_by else "code",
+                             {"type": "finite_number", "loc": loc, "msg": FINITE,
+                              "input": value})
+                for loc, value in _non_finite_leaves(params.model_dump(), ())]
+    if infinite:
+        raise ConfigError("\n".join(infinite))
     dumped = params.model_dump(mode="json")
     settings = [
         Setting(name, dumped[name], set_by[name].origin if name in set_by else "default",

@@ -262,3 +262,35 @@ def test_nothing_is_imported_after_the_command_ends(tmp_path: Path) -> None:
     modules = loaded_by("from zenav.cli import main\n"
                         f"assert main(['schemas', '--out', {str(tmp_path / 's')!r}]) == 0")
     assert "zenav.tooling" not in modules
+
+
+# --- numbers that are not finite ------------------------------------------------------
+
+
+@pytest.mark.parametrize(("value", "got"), [("inf", "inf"), ("1e400", "inf"), (".inf", "inf"),
+                                            ("-.inf", "-inf"), ("nan", "'nan'")])
+def test_params_refuses_a_non_finite_number(capsys: pytest.CaptureFixture[str], value: str,
+                                            got: str) -> None:
+    assert zenav_main(["params", "planner", "--set", f"cruise_speed={value}"]) == 2
+    assert one_line(capsys) == (f"zenav params: --set cruise_speed={value}: cruise_speed: "
+                                f"must be a finite number (got {got})")
+
+
+@pytest.mark.parametrize("assignment", ["perception.lambda_=1e400", "perception.lambda_=inf",
+                                        "planner.cruise_speed=inf", "planner.cruise_speed=nan"])
+def test_run_refuses_a_non_finite_number(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                         assignment: str) -> None:
+    out = tmp_path / "o"
+    assert zenav_main(["run", str(SCENARIO), "--out", str(out), "--set", assignment]) == 2
+    assert one_line(capsys).endswith("must be a finite number (got "
+                                     f"{'inf' if 'nan' not in assignment else repr('nan')})")
+    assert not out.exists()
+
+
+def test_a_parameter_file_with_inf_is_refused(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "perception.yaml"
+    path.write_text("lambda_: .inf\n")
+    assert service_main("perception", ["--config", str(path)]) == 2
+    assert one_line(capsys) == (f"zenav perception: {path}: lambda_: must be a finite number "
+                                "(got inf)")
