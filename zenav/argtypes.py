@@ -11,7 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 __all__ = ["count", "floats", "ints", "non_negative_float", "non_negative_int", "path",
-           "positive_float", "positive_int"]
+           "positive_float", "positive_float_at_most", "positive_int"]
 
 
 def path(text: str) -> Path:
@@ -69,6 +69,18 @@ def non_negative_int(text: str) -> int:
     if value < 0:
         raise argparse.ArgumentTypeError(f"must be >= 0 (got {text})")
     return value
+
+
+def positive_float_at_most(high: float) -> Callable[[str], float]:
+    """A finite number in (0, high]."""
+
+    def parse(text: str) -> float:
+        value = _float(text)
+        if not 0 < value <= high:
+            raise argparse.ArgumentTypeError(f"must be > 0 and <= {high:g} (got {text})")
+        return value
+
+    return parse
 
 
 def count(low: int, high: int) -> Callable[[str], int]:

@@ -294,3 +294,56 @@ def test_a_parameter_file_with_inf_is_refused(tmp_path: Path,
     assert service_main("perception", ["--config", str(path)]) == 2
     assert one_line(capsys) == (f"zenav perception: {path}: lambda_: must be a finite number "
                                 "(got inf)")
+
+
+# --- the benchmarks' numbers ---------------------------------------------------------
+
+BAD_NUMBERS = [
+    (["bench", "perf", "--obstacles", "-1"], "zenav bench perf: argument --obstacles: must be "
+     ">= 0 (got -1)"),
+    (["bench", "perf", "--rates", "abc"], "zenav bench perf: argument --rates: expected a "
+     "number (got 'abc')"),
+    (["bench", "perf", "--rates", "10,0"], "zenav bench perf: argument --rates: must be > 0 "
+     "(got 0)"),
+    (["bench", "perf", "--scans", "0"], "zenav bench perf: argument --scans: must be >= 1 "
+     "(got 0)"),
+    (["bench", "perf", "--latency-seconds", "-1"], "zenav bench perf: argument "
+     "--latency-seconds: must be > 0 (got -1)"),
+    (["bench", "perf", "--rate-seconds", "0"], "zenav bench perf: argument --rate-seconds: "
+     "must be > 0 (got 0)"),
+    (["bench", "accuracy", "--duration", "nan"], "zenav bench accuracy: argument --duration: "
+     "must be a finite number (got nan)"),
+    (["bench", "accuracy", "--seeds", "0"], "zenav bench accuracy: argument --seeds: must be "
+     ">= 1 (got 0)"),
+    (["soak", "--minutes", "-1"], "zenav soak: argument --minutes: must be > 0 (got -1)"),
+    (["soak", "--minutes", "0"], "zenav soak: argument --minutes: must be > 0 (got 0)"),
+    (["soak", "--rate-hz", "1e9"], "zenav soak: argument --rate-hz: must be > 0 and <= 10000 "
+     "(got 1e9)"),
+    (["soak", "--rate-hz", "nan"], "zenav soak: argument --rate-hz: must be a finite number "
+     "(got nan)"),
+    (["soak", "--warmup", "-1"], "zenav soak: argument --warmup: must be >= 0 (got -1)"),
+    (["soak", "--window", "0"], "zenav soak: argument --window: must be > 0 (got 0)"),
+    (["soak", "--max-growth", "nan"], "zenav soak: argument --max-growth: must be a finite "
+     "number (got nan)"),
+    (["bench", "nav", "--seed", "-1"], "zenav bench nav: argument --seed: must be >= 0 "
+     "(got -1)"),
+]
+
+
+@pytest.mark.parametrize(("argv", "line"), BAD_NUMBERS, ids=[" ".join(a) for a, _ in BAD_NUMBERS])
+def test_a_benchmarks_bad_number_names_its_option(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], line: str) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        zenav_main([*argv, "--out", str(tmp_path / "o")] if argv[1] != "accuracy" else argv)
+    assert exit_.value.code == 2
+    assert one_line(capsys) == line
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_benchmarks_defaults_pass_their_own_checks() -> None:
+    from zenav.cli import build_parser
+
+    perf = build_parser().parse_args(["bench", "perf"])
+    assert perf.obstacles == (0, 5, 20) and perf.rates == (10, 50, 100, 200, 300, 400, 600)
+    soak = build_parser().parse_args(["soak"])
+    assert (soak.minutes, soak.rate_hz, soak.warmup, soak.window) == (30.0, 100.0, 30.0, 60.0)

@@ -23,6 +23,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from zenav import argtypes
 from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch, verified_note
 from zenav.bench.common import machine, words
 from zenav.engine import ENGINES
@@ -341,7 +342,8 @@ def add_command(kinds: Any) -> None:
     nav.add_argument("--planners", default="paper,vfh,dwa,apf",
                      help="comma-separated planner names (default paper,vfh,dwa,apf)")
     nav.add_argument("--worlds", type=int, default=5, help="worlds per family (default 5)")
-    nav.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
+    nav.add_argument("--seed", type=argtypes.non_negative_int, default=0,
+                     help="first seed (default 0)")
     nav.add_argument("--families", default=",".join(FAMILIES),
                      help=f"comma-separated world families (default {','.join(FAMILIES)}); "
                      f"also {', '.join(UNSEEN)}, or unseen for all of those")

@@ -38,6 +38,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from zenav import argtypes
 from zenav.bench.common import machine, percentile, verdict, words
 from zenav.bench.compute import (
     TARGET_PIPELINE_20_MEDIAN_US,
@@ -164,9 +165,8 @@ def _command(args: argparse.Namespace) -> int:
               f"{', '.join(SECTIONS)}", file=sys.stderr)
         return 2
     run_perf(sections, args.out, scans=args.scans,
-             obstacle_counts=tuple(int(n) for n in words(args.obstacles)),
-             latency_seconds=args.latency_seconds,
-             rates=tuple(float(r) for r in words(args.rates)), rate_seconds=args.rate_seconds)
+             obstacle_counts=args.obstacles, latency_seconds=args.latency_seconds,
+             rates=args.rates, rate_seconds=args.rate_seconds)
     return 0
 
 
@@ -177,13 +177,16 @@ def add_command(kinds: Any) -> None:
     perf.add_argument("--sections", default="compute,latency,lockstep,engine,rate",
                       help="comma-separated: compute, latency (and memory), lockstep, "
                       "engine (the in-process engine's speed), rate")
-    perf.add_argument("--scans", type=int, default=200, help="scans timed per world (compute)")
-    perf.add_argument("--obstacles", default="0,5,20", help="obstacles in view (compute)")
-    perf.add_argument("--latency-seconds", type=float, default=30.0,
+    perf.add_argument("--scans", type=argtypes.positive_int, default=200,
+                      help="scans timed per world (compute)")
+    perf.add_argument("--obstacles", type=argtypes.ints(argtypes.non_negative_int),
+                      default="0,5,20", help="obstacles in view, comma-separated (compute)")
+    perf.add_argument("--latency-seconds", type=argtypes.positive_float, default=30.0,
                       help="wall seconds of the real-time run (latency)")
-    perf.add_argument("--rates", default="10,50,100,200,300,400,600",
-                      help="laser rates tried, Hz (rate)")
-    perf.add_argument("--rate-seconds", type=float, default=6.0,
+    perf.add_argument("--rates", type=argtypes.floats(argtypes.positive_float),
+                      default="10,50,100,200,300,400,600",
+                      help="laser rates tried, Hz, comma-separated (rate)")
+    perf.add_argument("--rate-seconds", type=argtypes.positive_float, default=6.0,
                       help="wall seconds measured per rate (rate)")
-    perf.add_argument("--out", type=Path, help="directory for perf.md and the runs")
+    perf.add_argument("--out", type=argtypes.path, help="directory for perf.md and the runs")
     perf.set_defaults(func=_command)

@@ -33,6 +33,7 @@ from typing import Any
 
 import yaml
 
+from zenav import argtypes
 from zenav.bench.common import rss_mb
 from zenav.launch import Stack
 from zenav.monitor.model import MonitorModel
@@ -206,17 +207,25 @@ def summary(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+MAX_RATE_HZ = 10_000.0
+"""The fastest laser a soak may ask for (a scan every 0.1 ms: far past what a stack on
+this machine keeps up with, and short of a clock that never advances)."""
+
+
 def add_command(sub: Any) -> None:
     soak = sub.add_parser("soak", help="run the stack in real time for a long time and "
                           "report memory, drops and latency")
-    soak.add_argument("--minutes", type=float, default=30.0)
-    soak.add_argument("--rate-hz", type=float, default=100.0,
-                      help="laser scan rate (default 100: 10x the paper's)")
-    soak.add_argument("--warmup", type=float, default=30.0, help="s before the first sample")
-    soak.add_argument("--window", type=float, default=60.0,
+    soak.add_argument("--minutes", type=argtypes.positive_float, default=30.0)
+    soak.add_argument("--rate-hz", type=argtypes.positive_float_at_most(MAX_RATE_HZ),
+                      default=100.0, help="laser scan rate (default 100: 10x the paper's; "
+                      f"at most {MAX_RATE_HZ:g})")
+    soak.add_argument("--warmup", type=argtypes.non_negative_float, default=30.0,
+                      help="s before the first sample")
+    soak.add_argument("--window", type=argtypes.positive_float, default=60.0,
                       help="s of latency samples at the start and at the end")
-    soak.add_argument("--max-growth", type=float, default=5.0, help="allowed RSS growth, %%")
-    soak.add_argument("--out", type=Path, default=Path("out/soak"))
+    soak.add_argument("--max-growth", type=argtypes.non_negative_float, default=5.0,
+                      help="allowed RSS growth, %%")
+    soak.add_argument("--out", type=argtypes.path, default=Path("out/soak"))
     soak.set_defaults(func=_cmd_soak)
 
 
