@@ -128,7 +128,7 @@ def test_a_service_that_dies_mid_run_ends_the_run_without_a_hang(tmp_path):
     finally:
         proc.kill()
     assert proc.returncode == 1
-    assert "service planner exited with status -9" in stderr
+    assert "service planner was killed by signal 9 (SIGKILL)" in stderr
 
 
 def test_every_service_stops_within_one_second_of_sigterm_or_sigint(tmp_path):
