@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from zenav.argtypes import one_line_errors, positive_float
 from zenav.bag.mcapfile import BagWriter
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
@@ -24,6 +25,19 @@ from zenav.tooling import (
     wait_for_event,
 )
 from zenav.writable import PathError, check_output_file
+
+
+def recordable_topic(topic: str) -> str:
+    """A topic ``--exclude`` can name (``scan``, ``sim/truth``, ``status/planner``, ...);
+    ArgumentTypeError listing them otherwise."""
+    from zenav.schemas import keys
+
+    names = [t.name for t in keys.TOPICS]
+    service = topic.removeprefix(keys.STATUS.name + "/")  # status/SERVICE
+    if topic in names or (service != topic and service.replace("_", "").isalnum()):
+        return topic
+    raise argparse.ArgumentTypeError(f"no topic {topic!r}; the topics are {', '.join(names)} "
+                                     f"and {keys.STATUS.name}/SERVICE")
 
 
 async def record(transport: Any, robot_id: str, path: Path, *, duration: float | None,
@@ -106,10 +120,12 @@ def main(args: argparse.Namespace) -> int:
 
 
 def add_command(sub: Any) -> None:
-    record = sub.add_parser("record", help="record every message of a robot to an MCAP file")
+    record = one_line_errors(
+        sub.add_parser("record", help="record every message of a robot to an MCAP file"))
     record.add_argument("file", type=Path)
-    record.add_argument("--duration", type=float, help="stop after this many s")
-    record.add_argument("--exclude", action="append", default=[], metavar="TOPIC",
+    record.add_argument("--duration", type=positive_float, help="stop after this many s")
+    record.add_argument("--exclude", type=recordable_topic, action="append", default=[],
+                        metavar="TOPIC",
                         help="leave out a topic, e.g. sim/truth (repeatable)")
     add_transport_arguments(record)
     add_connect_timeout(record)
