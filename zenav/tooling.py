@@ -265,25 +265,43 @@ def tool_setup(args: argparse.Namespace, command: str) -> tuple[str, TransportCo
 
 def run_tool(command: str, main: Coroutine[Any, Any, None],
              failures: tuple[type[Exception], ...] = ()) -> int:
-    """Run a tool's main coroutine to the end: 0 when it finishes or Ctrl-C stops it, 1 with
-    one line ``zenav COMMAND: reason`` when the router cannot be reached or one of
-    ``failures`` (the tool's own ways to fail at start, e.g. a port in use) is raised."""
+    """Run a tool's main coroutine to the end: 0 when it finishes, 130 (143) when SIGINT
+    (SIGTERM) stopped it, 1 with one line ``zenav COMMAND: reason`` when the router cannot
+    be reached or one of ``failures`` (the tool's own ways to fail at start, e.g. a port in
+    use) is raised."""
     expected: tuple[type[Exception], ...] = (ConnectError, *failures)
     try:
-        with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(main)
+        asyncio.run(main)
+    except KeyboardInterrupt:
+        return 130
     except expected as exc:
         print(f"zenav {command}: {exc}", file=sys.stderr)
         return 1
-    return 0
+    return signal_status(0)
+
+
+_SIGNALLED: list[int] = []
+"""The signals :func:`stop_on_signals` caught in this process, in order."""
+
+
+def signal_status(otherwise: int) -> int:
+    """The exit status of a tool that has stopped: 128 + the signal that stopped it (130
+    for SIGINT, 143 for SIGTERM, as a shell expects), else ``otherwise``."""
+    return 128 + _SIGNALLED[0] if _SIGNALLED else otherwise
 
 
 def stop_on_signals(stop: asyncio.Event) -> None:
-    """Set ``stop`` on SIGINT or SIGTERM (call from the running loop's thread)."""
+    """Set ``stop`` on SIGINT or SIGTERM (call from the running loop's thread); the signal
+    is kept for :func:`signal_status`."""
     loop = asyncio.get_running_loop()
+
+    def caught(signum: int) -> None:
+        _SIGNALLED.append(signum)
+        stop.set()
+
     for signum in (signal.SIGINT, signal.SIGTERM):
         with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(signum, stop.set)
+            loop.add_signal_handler(signum, caught, signum)
 
 
 async def wait_for_event(event: asyncio.Event, timeout: float | None) -> bool:

@@ -1,7 +1,7 @@
 """The tools' bad input (``monitor``, ``record``, ``replay``, ``rviz``, ``foxglove``,
 ``up``): each mistake is one line naming it and exit status 2, found before any session
 opens or anything starts (a transport file, a transport option, a number or a name the
-parser refuses, ``up``'s run directory).
+parser refuses, ``up``'s run directory); and the status a tool ends with after a signal.
 
 Every CLI row runs the real ``zenav`` entry point in this process; none gets as far as
 opening a Zenoh session.
@@ -9,7 +9,10 @@ opening a Zenoh session.
 
 from __future__ import annotations
 
+import asyncio
 import math
+import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -206,3 +209,33 @@ def test_the_argument_types_take_good_values() -> None:
         with pytest.raises(Exception, match="number"):
             argtypes.positive_float(bad)
     assert math.isfinite(argtypes.positive_float("1e300"))
+
+
+GUARD = 30.0
+"""s after which a wait that should have ended counts as hung (not a speed target)."""
+
+
+# --- the exit status after a signal -------------------------------------------------
+
+
+@pytest.mark.parametrize(("signum", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_tool_stopped_by_a_signal_ends_with_128_plus_its_number(
+        signum: signal.Signals, status: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(tooling, "_SIGNALLED", [])
+
+    async def tool() -> None:
+        stop = asyncio.Event()
+        tooling.stop_on_signals(stop)
+        os.kill(os.getpid(), signum)
+        await asyncio.wait_for(stop.wait(), GUARD)
+
+    assert tooling.run_tool("test", tool()) == status
+
+
+def test_a_tool_that_ends_by_itself_ends_with_0(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(tooling, "_SIGNALLED", [])
+
+    async def tool() -> None:
+        tooling.stop_on_signals(asyncio.Event())
+
+    assert tooling.run_tool("test", tool()) == 0

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import sys
 import time
 from pathlib import Path
@@ -20,6 +19,7 @@ from zenav.tooling import (
     StampedSubscriber,
     add_connect_timeout,
     open_bus,
+    signal_status,
     stop_on_signals,
     tool_setup,
     wait_for_event,
@@ -96,18 +96,19 @@ def main(args: argparse.Namespace) -> int:
         return 2
     started = time.monotonic()
     try:
-        with contextlib.suppress(KeyboardInterrupt):
-            done = asyncio.run(record(transport, robot_id, args.file, duration=args.duration,
-                                      exclude=tuple(args.exclude),
-                                      connect_timeout=args.connect_timeout))
-            if done is None:
-                print("zenav record: stopped before the session opened; nothing recorded",
-                      file=sys.stderr)
-                return 0
-            count, changes = done
-            print(f"zenav record: {count} messages and {changes} liveliness changes in "
-                  f"{time.monotonic() - started:.1f} s -> {args.file} "
-                  f"({args.file.stat().st_size} B)", flush=True)
+        done = asyncio.run(record(transport, robot_id, args.file, duration=args.duration,
+                                  exclude=tuple(args.exclude),
+                                  connect_timeout=args.connect_timeout))
+        if done is None:
+            print("zenav record: stopped before the session opened; nothing recorded",
+                  file=sys.stderr)
+            return signal_status(0)
+        count, changes = done
+        print(f"zenav record: {count} messages and {changes} liveliness changes in "
+              f"{time.monotonic() - started:.1f} s -> {args.file} "
+              f"({args.file.stat().st_size} B)", flush=True)
+    except KeyboardInterrupt:
+        return 130
     except ConnectError as exc:
         print(f"zenav record: {exc}", file=sys.stderr)
         return 1
@@ -115,7 +116,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"zenav record: {args.file}: cannot write ({exc.strerror or exc})",
               file=sys.stderr)
         return 2
-    return 0
+    return signal_status(0)  # 130 after SIGINT: the file is complete all the same
 
 
 
