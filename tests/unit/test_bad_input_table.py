@@ -107,6 +107,19 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["replay", str(a_bag(t)), "--topics", "odom,bogus",
                 "--connect", "tcp/127.0.0.1:9"], 2,
      "zenav replay: --topics: bogus not in {t}/run.mcap (it has odom)"),
+    ("replay --wait-for a name no process has",
+     lambda t: ["replay", str(a_bag(t)), "--wait-for", "planer", "--connect", "tcp/127.0.0.1:9"],
+     2, "zenav replay: --wait-for: no process is called planer (the names are simulator, "
+     "laser_driver, perception, tracking, planner, motor_bridge, router, record, run)"),
+    ("monitor --connect something not an endpoint",
+     lambda t: ["monitor", "--connect", "garbage"], 2,
+     "zenav monitor: --connect: 'garbage' is not a Zenoh endpoint: expected PROTOCOL/ADDRESS, "
+     "e.g. tcp/127.0.0.1:7447"),
+    ("up --connect something not an endpoint",
+     lambda t: ["up", "--run-dir", str(t / "run"), "--config",
+                str(REPO / "deploy" / "server.yaml"), "--connect", "garbage"], 2,
+     "zenav up: --connect: 'garbage' is not a Zenoh endpoint: expected PROTOCOL/ADDRESS, "
+     "e.g. tcp/127.0.0.1:7447"),
     ("run --planner foo",
      lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--planner", "foo"], 2,
      f"zenav run: --planner 'foo': no such planner; choose from {', '.join(PLANNERS)}"),
