@@ -85,3 +85,24 @@ def test_up_refuses_a_bad_endpoint_in_the_deployment_file(
     assert err == [f"zenav up: {path}: transport.connect.0: 'tcpx/127.0.0.1:7447': unknown "
                    "protocol 'tcpx' (one of tcp, udp, tls, quic, ws, unixsock-stream, "
                    "unixpipe, serial, vsock), e.g. tcp/127.0.0.1:7447"]
+
+
+@pytest.mark.parametrize(("option", "line"), [
+    (["--listen", "garbage"], "--listen: 'garbage' is not a Zenoh endpoint: expected "
+     "PROTOCOL/ADDRESS, e.g. tcp/127.0.0.1:7447"),
+    (["--connect", "tcp/127.0.0.1:99999"],
+     "--connect: 'tcp/127.0.0.1:99999': port 99999 is not from 0 to 65535"),
+])
+def test_the_router_refuses_a_bad_endpoint_in_one_line(
+        option: list[str], line: str, capsys: pytest.CaptureFixture[str]) -> None:
+    code, err = zenav(["router", *option], capsys)
+    assert (code, err) == (2, [f"zenav router: {line}"])
+
+
+def test_the_router_names_the_field_of_a_bad_transport_file(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text("listen: [tcp/0.0.0.0:7447]\nconnect: [garbage]\n")
+    code, err = zenav(["router", "--transport", str(path)], capsys)
+    assert (code, err) == (2, [f"zenav router: {path}: connect.0: 'garbage' is not a Zenoh "
+                               "endpoint: expected PROTOCOL/ADDRESS, e.g. tcp/127.0.0.1:7447"])
