@@ -1,74 +1,146 @@
-"""Argument types the commands share: a bad value is refused by argparse, before anything
-starts, with the option's name and what it must be (exit status 2)."""
+"""Argument types for argparse shared by the commands: each turns the text into the value
+or raises ``argparse.ArgumentTypeError`` with what is wrong, so a bad number or path is
+one line naming the option (``zenav soak: argument --minutes: must be > 0 (got -1)``),
+status 2, before any work starts."""
 
 from __future__ import annotations
 
 import argparse
 import math
 from collections.abc import Callable
+from pathlib import Path
 from typing import NoReturn
 
+__all__ = ["count", "float_at_least", "floats", "ints", "non_negative_float",
+           "non_negative_int", "nonempty", "one_line_errors", "path", "port", "positive_float",
+           "positive_int"]
 
-def _number(text: str) -> float:
+
+def path(text: str) -> Path:
+    """A file or folder path; refused when empty (``--out ""`` would be the current
+    folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("the path is empty")
+    return Path(text)
+
+
+def _float(text: str) -> float:
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-
-
-def positive_float(text: str) -> float:
-    """A finite number above 0 (a duration, a period, a rate, a timeout)."""
-    value = _number(text)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number above 0, not {text}")
+        raise argparse.ArgumentTypeError(f"expected a number (got {text!r})") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number (got {text})")
     return value
 
 
-def float_at_least(low: float) -> Callable[[str], float]:
-    """A finite number of at least ``low``."""
-
-    def check(text: str) -> float:
-        value = _number(text)
-        if not (math.isfinite(value) and value >= low):
-            raise argparse.ArgumentTypeError(f"must be a finite number of at least {low:g}, "
-                                             f"not {text}")
-        return value
-
-    return check
+def _int(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number (got {text!r})") from None
 
 
-def int_between(low: int, high: int) -> Callable[[str], int]:
-    """A whole number from ``low`` to ``high``, both included."""
+def positive_float(text: str) -> float:
+    """A finite number > 0."""
+    value = _float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be > 0 (got {text})")
+    return value
 
-    def check(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+
+def non_negative_float(text: str) -> float:
+    """A finite number >= 0."""
+    value = _float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0 (got {text})")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """A whole number >= 1."""
+    value = _int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1 (got {text})")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    """A whole number >= 0."""
+    value = _int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0 (got {text})")
+    return value
+
+
+def count(low: int, high: int) -> Callable[[str], int]:
+    """A whole number in [low, high]."""
+
+    def parse(text: str) -> int:
+        value = _int(text)
         if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"must be from {low} to {high}, not {value}")
+            raise argparse.ArgumentTypeError(f"must be in {low}..{high} (got {text})")
         return value
 
-    return check
+    return parse
 
 
-port = int_between(0, 65535)
+def floats(item: Callable[[str], float]) -> Callable[[str], tuple[float, ...]]:
+    """A comma-separated list of at least one number, each checked by ``item``."""
+
+    def parse(text: str) -> tuple[float, ...]:
+        parts = [part.strip() for part in text.split(",") if part.strip()]
+        if not parts:
+            raise argparse.ArgumentTypeError(f"expected numbers separated by commas "
+                                             f"(got {text!r})")
+        return tuple(item(part) for part in parts)
+
+    return parse
+
+
+def ints(item: Callable[[str], int]) -> Callable[[str], tuple[int, ...]]:
+    """A comma-separated list of at least one whole number, each checked by ``item``."""
+
+    def parse(text: str) -> tuple[int, ...]:
+        parts = [part.strip() for part in text.split(",") if part.strip()]
+        if not parts:
+            raise argparse.ArgumentTypeError(f"expected whole numbers separated by commas "
+                                             f"(got {text!r})")
+        return tuple(item(part) for part in parts)
+
+    return parse
+
+
+def float_at_least(low: float) -> Callable[[str], float]:
+    """A finite number >= ``low``."""
+
+    def parse(text: str) -> float:
+        value = _float(text)
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be >= {low:g} (got {text})")
+        return value
+
+    return parse
+
+
+port = count(0, 65535)
 """A TCP or UDP port."""
 
 
 def nonempty(text: str) -> str:
-    """A string with something in it but blanks."""
+    """A string with more than blanks in it."""
     if not text.strip():
         raise argparse.ArgumentTypeError("must not be empty")
     return text
 
 
 def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """``parser``, whose refusals are one line ``PROG: --option: problem`` and exit status
-    2, without the usage summary argparse prints before them (``--help`` still shows it)."""
+    """``parser``, whose refusals are one line ``PROG: argument --option: problem`` and
+    exit status 2, without the usage summary argparse prints before them (``--help``
+    still shows it)."""
 
     def error(message: str) -> NoReturn:
-        parser.exit(2, f"{parser.prog}: {message.removeprefix('argument ')}\n")
+        parser.exit(2, f"{parser.prog}: {message}\n")
 
     parser.error = error  # type: ignore[method-assign]
     return parser

@@ -20,7 +20,7 @@ import contextlib
 import sys
 from typing import Any
 
-from zenav.argtypes import int_between, nonempty, one_line_errors
+from zenav.argtypes import count, nonempty, one_line_errors
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
@@ -173,7 +173,7 @@ def add_command(sub: Any) -> None:
         "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic, "
         "the planner's global path as nav_msgs/msg/Path on another and its occupancy map "
         "as nav_msgs/msg/OccupancyGrid on a third."))
-    rviz.add_argument("--domain-id", type=int_between(0, MAX_DOMAIN_ID), default=0,
+    rviz.add_argument("--domain-id", type=count(0, MAX_DOMAIN_ID), default=0,
                       help=f"ROS_DOMAIN_ID, 0 to {MAX_DOMAIN_ID} (default 0)")
     rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
     rviz.add_argument("--path-topic", default="/zenav/plan",

@@ -251,4 +251,4 @@ def test_a_map_scale_of_zero_is_refused_in_one_line(capsys):
         zenav_main(["monitor", "--map-scale", "0"])
     assert refused.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["zenav monitor: --map-scale: must be a finite number above 0, not 0"]
+    assert err == ["zenav monitor: argument --map-scale: must be > 0 (got 0)"]

@@ -9,6 +9,7 @@ opening a Zenoh session.
 
 from __future__ import annotations
 
+import argparse
 import asyncio
 import math
 import os
@@ -107,42 +108,30 @@ def test_a_tool_refuses_a_bad_transport_option_in_one_line(
 
 
 @pytest.mark.parametrize(("argv", "line"), [
-    (["monitor", "--period", "0"], "argument --period: must be a finite number of at least "
-     "0.01, not 0"),
-    (["monitor", "--jsonl", "--period", "-1"], "argument --period: must be a finite number "
-     "of at least 0.01, not -1"),
-    (["monitor", "--duration", "nan"], "argument --duration: must be a finite number above "
-     "0, not nan"),
-    (["monitor", "--duration", "0"], "argument --duration: must be a finite number above "
-     "0, not 0"),
-    (["monitor", "--silence", "-1"], "argument --silence: must be a finite number above 0, "
-     "not -1"),
-    (["monitor", "--map-scale", "inf"], "argument --map-scale: must be a finite number above "
-     "0, not inf"),
-    (["monitor", "--connect-timeout", "-1"], "argument --connect-timeout: must be a finite "
-     "number above 0, not -1"),
-    (["record", "x.mcap", "--duration", "-1"], "argument --duration: must be a finite number "
-     "above 0, not -1"),
-    (["record", "x.mcap", "--exclude", "bogus"], "argument --exclude: no topic 'bogus'; the "
+    (["monitor", "--period", "0"], "--period: must be >= 0.01 (got 0)"),
+    (["monitor", "--jsonl", "--period", "-1"], "--period: must be >= 0.01 (got -1)"),
+    (["monitor", "--duration", "nan"], "--duration: must be a finite number (got nan)"),
+    (["monitor", "--duration", "0"], "--duration: must be > 0 (got 0)"),
+    (["monitor", "--silence", "-1"], "--silence: must be > 0 (got -1)"),
+    (["monitor", "--map-scale", "inf"], "--map-scale: must be a finite number (got inf)"),
+    (["monitor", "--connect-timeout", "-1"], "--connect-timeout: must be > 0 (got -1)"),
+    (["record", "x.mcap", "--duration", "-1"], "--duration: must be > 0 (got -1)"),
+    (["record", "x.mcap", "--exclude", "bogus"], "--exclude: no topic 'bogus'; the "
      "topics are device/laser, device/base_cmd, scan, odom, obstacles, tracks, cmd_vel, "
      "planner/events, planner/state, planner/path, planner/map, sim/truth, sim/result and "
      "status/SERVICE"),
-    (["foxglove", "--duration", "-1"], "argument --duration: must be a finite number above "
-     "0, not -1"),
-    (["foxglove", "--port", "70000"], "argument --port: must be from 0 to 65535, not 70000"),
-    (["rviz", "--domain-id", "-1"], "argument --domain-id: must be from 0 to 232, not -1"),
-    (["rviz", "--domain-id", "99999"], "argument --domain-id: must be from 0 to 232, not "
-     "99999"),
-    (["rviz", "--frame", ""], "argument --frame: must not be empty"),
-    (["up", "--timeout", "nan"], "argument --timeout: must be a finite number above 0, not "
-     "nan"),
-    (["up", "--timeout", "-1"], "argument --timeout: must be a finite number above 0, not "
-     "-1"),
+    (["foxglove", "--duration", "-1"], "--duration: must be > 0 (got -1)"),
+    (["foxglove", "--port", "70000"], "--port: must be in 0..65535 (got 70000)"),
+    (["rviz", "--domain-id", "-1"], "--domain-id: must be in 0..232 (got -1)"),
+    (["rviz", "--domain-id", "99999"], "--domain-id: must be in 0..232 (got 99999)"),
+    (["rviz", "--frame", ""], "--frame: must not be empty"),
+    (["up", "--timeout", "nan"], "--timeout: must be a finite number (got nan)"),
+    (["up", "--timeout", "-1"], "--timeout: must be > 0 (got -1)"),
 ])
 def test_a_bad_number_or_name_is_refused_by_the_parser(
         argv: list[str], line: str, capsys: pytest.CaptureFixture[str]) -> None:
     code, err = zenav(argv, capsys)
-    assert (code, err) == (2, [f"zenav {argv[0]}: {line.removeprefix('argument ')}"])
+    assert (code, err) == (2, [f"zenav {argv[0]}: argument {line}"])
 
 
 def test_record_excludes_a_status_topic(tmp_path: Path) -> None:
@@ -206,7 +195,7 @@ def test_the_argument_types_take_good_values() -> None:
     assert argtypes.port("0") == 0 and argtypes.port("65535") == 65535
     assert argtypes.nonempty("odom") == "odom"
     for bad in ("0", "-1", "nan", "inf", "x"):
-        with pytest.raises(Exception, match="number"):
+        with pytest.raises(argparse.ArgumentTypeError):
             argtypes.positive_float(bad)
     assert math.isfinite(argtypes.positive_float("1e300"))
 
