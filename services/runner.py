@@ -36,7 +36,7 @@ from zenav.services.config import (
     read_yaml,
 )
 from zenav.services.inputs import OneLineParser
-from zenav.services.transport import Bus, TransportConfig, ZenohBus
+from zenav.services.transport import Bus, TransportConfig, ZenohBus, check_endpoint
 
 if TYPE_CHECKING:
     from zenav.schemas.keys import Keys
@@ -138,14 +138,24 @@ def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
                        help="robot id in every key (default robot0)")
     group.add_argument("--transport", type=Path, help="YAML file of transport settings")
     group.add_argument("--mode", choices=["peer", "client", "router"], help="Zenoh mode")
-    group.add_argument("--listen", action="append", default=[], metavar="ENDPOINT")
-    group.add_argument("--connect", action="append", default=[], metavar="ENDPOINT")
+    group.add_argument("--listen", action="append", default=[], type=endpoint,
+                       metavar="ENDPOINT")
+    group.add_argument("--connect", action="append", default=[], type=endpoint,
+                       metavar="ENDPOINT")
     group.add_argument(
         "--base-port",
         type=base_port,
         default=DEFAULT_BASE_PORT,
         help="first port of the loopback mesh used when no endpoint is given",
     )
+
+
+def endpoint(text: str) -> str:
+    """``--listen`` / ``--connect``: a Zenoh endpoint of the form Zenoh accepts."""
+    try:
+        return check_endpoint(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def base_port(text: str) -> int:

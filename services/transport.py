@@ -23,10 +23,10 @@ import uuid
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import zenoh
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 log = logging.getLogger(__name__)
 
@@ -36,6 +36,43 @@ LivelinessCallback = Callable[[str, bool], None]
 Snapshot = Callable[[], list[bytes]]
 """Answers a query with payloads. Called on a middleware thread: it must only read
 (copy) data, never touch the asyncio loop."""
+
+
+ENDPOINT_PROTOCOLS: dict[str, bool] = {
+    "tcp": True, "udp": True, "tls": True, "quic": True, "ws": True,
+    "unixsock-stream": False, "unixpipe": False, "serial": False, "vsock": False,
+}
+"""The link protocols of a Zenoh endpoint, each with whether its address ends in a port."""
+
+
+def check_endpoint(endpoint: str) -> str:
+    """``endpoint`` when it has the form Zenoh accepts, ``PROTOCOL/ADDRESS`` with an
+    optional ``?metadata`` and ``#config`` (e.g. ``tcp/127.0.0.1:7447``,
+    ``unixsock-stream//tmp/zenoh.sock``), a port from 0 to 65535 where the protocol takes
+    one; else ValueError with one line saying what is wrong. Zenoh's own refusal comes
+    only when the session opens, as a multi-line error."""
+    example = "e.g. tcp/127.0.0.1:7447"
+    protocol, slash, rest = endpoint.partition("/")
+    address = rest.split("?", 1)[0].split("#", 1)[0]
+    if not slash or not address:
+        raise ValueError(f"{endpoint!r} is not a Zenoh endpoint: expected PROTOCOL/ADDRESS, "
+                         f"{example}")
+    if protocol not in ENDPOINT_PROTOCOLS:
+        raise ValueError(f"{endpoint!r}: unknown protocol {protocol!r} (one of "
+                         f"{', '.join(ENDPOINT_PROTOCOLS)}), {example}")
+    if ENDPOINT_PROTOCOLS[protocol]:
+        host, colon, port = address.rpartition(":")
+        if not colon or not host or not port.isdigit():
+            raise ValueError(f"{endpoint!r}: expected {protocol}/HOST:PORT, {example}")
+        if int(port) > 65535:
+            raise ValueError(f"{endpoint!r}: port {port} is not from 0 to 65535")
+        if host.startswith("[") != host.endswith("]") or any(c.isspace() for c in host):
+            raise ValueError(f"{endpoint!r}: {host!r} is not a host name or address")
+    return endpoint
+
+
+Endpoint = Annotated[str, AfterValidator(check_endpoint)]
+"""A Zenoh endpoint, checked by :func:`check_endpoint`."""
 
 
 class TransportConfig(BaseModel):
@@ -49,10 +86,11 @@ class TransportConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     mode: Literal["peer", "client", "router"] = "peer"
-    listen: list[str] = Field(
+    listen: list[Endpoint] = Field(
         default_factory=list, description="endpoints, e.g. tcp/127.0.0.1:7450"
     )
-    connect: list[str] = Field(default_factory=list, description="endpoints to connect to")
+    connect: list[Endpoint] = Field(default_factory=list,
+                                    description="endpoints to connect to")
     multicast_scouting: bool = False
     lease_ms: int = Field(1000, ge=100, description="link lease: how soon a dead peer is noticed")
     extra: dict[str, Any] = Field(

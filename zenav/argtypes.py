@@ -10,8 +10,9 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["count", "floats", "ints", "non_negative_float", "non_negative_int", "path",
-           "positive_float", "positive_float_at_most", "positive_int"]
+__all__ = ["count", "float_at_least", "floats", "ints", "non_negative_float",
+           "non_negative_int", "nonempty", "path", "port", "positive_float",
+           "positive_float_at_most", "positive_int"]
 
 
 def path(text: str) -> Path:
@@ -119,3 +120,27 @@ def ints(item: Callable[[str], int]) -> Callable[[str], tuple[int, ...]]:
         return tuple(item(part) for part in parts)
 
     return parse
+
+
+def float_at_least(low: float) -> Callable[[str], float]:
+    """A finite number >= ``low``."""
+
+    def parse(text: str) -> float:
+        value = _float(text)
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be >= {low:g} (got {text})")
+        return value
+
+    return parse
+
+
+port = count(0, 65535)
+"""A TCP or UDP port."""
+
+
+def nonempty(text: str) -> str:
+    """A string with more than blanks in it."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must not be empty")
+    return text
+

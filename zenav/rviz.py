@@ -20,6 +20,7 @@ import contextlib
 import sys
 from typing import Any
 
+from zenav.argtypes import count, nonempty
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
@@ -36,6 +37,10 @@ from zenav.tooling import (
     stop_on_signals,
     tool_setup,
 )
+
+MAX_DOMAIN_ID = 232
+"""The highest ROS_DOMAIN_ID (the one :class:`zenav.services.ros2.wire.NodeIdentity`
+accepts)."""
 
 
 class RvizView:
@@ -168,13 +173,15 @@ def add_command(sub: Any) -> None:
         "scenario and action as visualization_msgs/msg/MarkerArray on a ROS 2 topic, "
         "the planner's global path as nav_msgs/msg/Path on another and its occupancy map "
         "as nav_msgs/msg/OccupancyGrid on a third.")
-    rviz.add_argument("--domain-id", type=int, default=0, help="ROS_DOMAIN_ID (default 0)")
+    rviz.add_argument("--domain-id", type=count(0, MAX_DOMAIN_ID), default=0,
+                      help=f"ROS_DOMAIN_ID, 0 to {MAX_DOMAIN_ID} (default 0)")
     rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
     rviz.add_argument("--path-topic", default="/zenav/plan",
                       help="Path topic (default /zenav/plan)")
     rviz.add_argument("--map-topic", default="/zenav/map",
                       help="OccupancyGrid topic (default /zenav/map)")
-    rviz.add_argument("--frame", default="odom", help="frame of zenav's poses (default odom)")
+    rviz.add_argument("--frame", type=nonempty, default="odom",
+                      help="frame of zenav's poses (default odom)")
     add_transport_arguments(rviz)
     add_connect_timeout(rviz)
     rviz.set_defaults(func=main)

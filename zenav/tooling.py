@@ -17,8 +17,13 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Coroutine
+from pathlib import Path
 from typing import Any, TypeVar
 
+from pydantic import ValidationError
+
+from zenav.argtypes import positive_float
+from zenav.services.config import ConfigError
 from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
@@ -56,12 +61,65 @@ def client_transport(connect: list[str], **extra: Any) -> TransportConfig:
 
 def tool_transport(args: argparse.Namespace) -> TransportConfig:
     """Transport of a tool from the shared transport options (see module doc). A client
-    gives up on a missing router after ``--connect-timeout`` s instead of waiting forever."""
+    gives up on a missing router after ``--connect-timeout`` s instead of waiting forever.
+    A bad option or transport file is a ConfigError with one line per problem."""
     if args.connect and args.mode is None and args.transport is None:
         config = client_transport(list(args.connect))
+    elif args.transport is not None:
+        config = read_transport(args.transport)
+        if args.mode is not None:
+            config = config.model_copy(update={"mode": args.mode})
+        config = with_client_defaults(config)
     else:
         config = with_client_defaults(transport_from_args(args, None))
     return with_connect_timeout(config, getattr(args, "connect_timeout", CONNECT_TIMEOUT))
+
+
+def read_transport(path: Path) -> TransportConfig:
+    """A transport file; ConfigError with one line per problem, each naming the file (and
+    the field, when one is wrong)."""
+    import yaml
+
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"{path}: not a text file") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML ({yaml_problem(exc)})") from None
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: expected a mapping of transport settings "
+                          f"({', '.join(TransportConfig.model_fields)})")
+    try:
+        return TransportConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError("\n".join(validation_lines(str(path), exc))) from None
+
+
+def yaml_problem(exc: Exception) -> str:
+    """PyYAML's error in one line: where, and what is wrong there."""
+    import yaml
+
+    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
+        mark = exc.problem_mark
+        return f"line {mark.line + 1}, column {mark.column + 1}: {exc.problem}"
+    return " ".join(str(exc).split())
+
+
+def validation_lines(source: str, exc: ValidationError) -> list[str]:
+    """One line per problem of a pydantic error: the source, the field, what is wrong."""
+    lines = []
+    for error in exc.errors(include_url=False):
+        where = ".".join(str(part) for part in error["loc"]) or "(top level)"
+        message = error["msg"].removeprefix("Value error, ")
+        got = "" if error["type"] in ("missing", "value_error") else f" (got {error['input']!r})"
+        lines.append(f"{source}: {where}: {message}{got}")
+    return lines
 
 
 def with_connect_timeout(config: TransportConfig, timeout: float) -> TransportConfig:
@@ -75,7 +133,8 @@ def with_connect_timeout(config: TransportConfig, timeout: float) -> TransportCo
 
 
 def add_connect_timeout(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--connect-timeout", type=float, default=CONNECT_TIMEOUT, metavar="S",
+    parser.add_argument("--connect-timeout", type=positive_float, default=CONNECT_TIMEOUT,
+                        metavar="S",
                         help="s to wait for the router before giving up "
                         f"(default {CONNECT_TIMEOUT:g})")
 
@@ -179,36 +238,54 @@ def tool_setup(args: argparse.Namespace, command: str) -> tuple[str, TransportCo
     """(robot id, transport) of a tool from its options; None after printing the reason
     (the tool then exits with status 2)."""
     from zenav.schemas.keys import check_robot_id
-    from zenav.services.config import ConfigError
 
     try:
         return check_robot_id(args.robot_id), tool_transport(args)
     except (ConfigError, ValueError) as exc:
-        print(f"zenav {command}: {exc}", file=sys.stderr)
+        for line in str(exc).splitlines():  # one per problem
+            print(f"zenav {command}: {line}", file=sys.stderr)
         return None
 
 
 def run_tool(command: str, main: Coroutine[Any, Any, None],
              failures: tuple[type[Exception], ...] = ()) -> int:
-    """Run a tool's main coroutine to the end: 0 when it finishes or Ctrl-C stops it, 1 with
-    one line ``zenav COMMAND: reason`` when the router cannot be reached or one of
-    ``failures`` (the tool's own ways to fail at start, e.g. a port in use) is raised."""
+    """Run a tool's main coroutine to the end: 0 when it finishes, 130 (143) when SIGINT
+    (SIGTERM) stopped it, 1 with one line ``zenav COMMAND: reason`` when the router cannot
+    be reached or one of ``failures`` (the tool's own ways to fail at start, e.g. a port in
+    use) is raised."""
     expected: tuple[type[Exception], ...] = (ConnectError, *failures)
     try:
-        with contextlib.suppress(KeyboardInterrupt):
-            asyncio.run(main)
+        asyncio.run(main)
+    except KeyboardInterrupt:
+        return 130
     except expected as exc:
         print(f"zenav {command}: {exc}", file=sys.stderr)
         return 1
-    return 0
+    return signal_status(0)
+
+
+_SIGNALLED: list[int] = []
+"""The signals :func:`stop_on_signals` caught in this process, in order."""
+
+
+def signal_status(otherwise: int) -> int:
+    """The exit status of a tool that has stopped: 128 + the signal that stopped it (130
+    for SIGINT, 143 for SIGTERM, as a shell expects), else ``otherwise``."""
+    return 128 + _SIGNALLED[0] if _SIGNALLED else otherwise
 
 
 def stop_on_signals(stop: asyncio.Event) -> None:
-    """Set ``stop`` on SIGINT or SIGTERM (call from the running loop's thread)."""
+    """Set ``stop`` on SIGINT or SIGTERM (call from the running loop's thread); the signal
+    is kept for :func:`signal_status`."""
     loop = asyncio.get_running_loop()
+
+    def caught(signum: int) -> None:
+        _SIGNALLED.append(signum)
+        stop.set()
+
     for signum in (signal.SIGINT, signal.SIGTERM):
         with contextlib.suppress(NotImplementedError, RuntimeError):
-            loop.add_signal_handler(signum, stop.set)
+            loop.add_signal_handler(signum, caught, signum)
 
 
 async def wait_for_event(event: asyncio.Event, timeout: float | None) -> bool:

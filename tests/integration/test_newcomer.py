@@ -154,7 +154,8 @@ def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: 
             except subprocess.TimeoutExpired:
                 proc.kill()
                 codes[name] = proc.wait()
-    assert codes == {name: 0 for name in procs}, codes
+    # SIGINT: the services end cleanly with 0, the recorder (a tool) with 130
+    assert codes == {name: 130 if name == "record" else 0 for name in procs}, codes
     goal = list(scenario.robot.goal)
     # The global path is published once, at the planner's first decision, and a recorder
     # in this peer setup does not always hear that first message (an open fault, see the

@@ -81,6 +81,35 @@ def test_a_tool_with_a_dead_peer_honours_its_duration(tool: str, tmp_path: Path)
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_replay_waiting_for_a_service_says_so_and_stops_at_once_on_a_signal(
+        signum: signal.Signals, tmp_path: Path,
+        measure: Callable[[str, float, str], None]) -> None:
+    proc = subprocess.Popen(zenav("replay", str(a_bag(tmp_path)), "--wait-for", "planner",
+                                  "--timeout", "120", "--mode", "peer", "--connect", nobody()),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            stdin=subprocess.DEVNULL)
+    try:
+        lines = _stderr_lines(proc)
+        first = lines.get(timeout=HANG)
+        assert first == "zenav replay: waiting for planner on robot robot0 (up to 120 s)"
+        sent = time.monotonic()
+        proc.send_signal(signum)
+        code = proc.wait(timeout=10)
+        took = time.monotonic() - sent
+        assert proc.stdout is not None
+        said = proc.stdout.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    measure(f"replay stops on {signum.name} while waiting for a service", took, "")
+    assert code == 128 + signum
+    assert took < 3.0, f"replay took {took:.2f} s to stop"
+    assert said.startswith("zenav replay: 0 messages in "), said
+    assert said.rstrip().endswith("; stopped by a signal"), said
+
+
 def test_replay_to_a_dead_peer_publishes_and_ends(tmp_path: Path) -> None:
     done = run(zenav("replay", str(a_bag(tmp_path)), "--rate", "10", "--mode", "peer",
                      "--connect", nobody()), timeout=HANG)
@@ -124,7 +153,7 @@ def test_a_tool_waiting_for_its_router_stops_at_once_on_a_signal(
             proc.kill()
             proc.wait()
     measure(f"{tool} stops on {signum.name} while connecting", took, "")
-    assert code == 0
+    assert code == 128 + signum  # 130 for SIGINT, as a shell expects
     assert took < 1.0, f"{tool} took {took:.2f} s to stop"
     assert not (tmp_path / "out.mcap").exists()
 

@@ -54,7 +54,7 @@ def recorder(path: Path, endpoint: str) -> subprocess.Popen[str]:
 def stop(proc: subprocess.Popen[str]) -> str:
     proc.send_signal(signal.SIGINT)
     out, _ = proc.communicate(timeout=15)
-    assert proc.returncode == 0, out
+    assert proc.returncode == 130, out  # stopped by SIGINT, the file complete all the same
     return out
 
 

@@ -107,6 +107,19 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["replay", str(a_bag(t)), "--topics", "odom,bogus",
                 "--connect", "tcp/127.0.0.1:9"], 2,
      "zenav replay: --topics: bogus not in {t}/run.mcap (it has odom)"),
+    ("replay --wait-for a name no process has",
+     lambda t: ["replay", str(a_bag(t)), "--wait-for", "planer", "--connect", "tcp/127.0.0.1:9"],
+     2, "zenav replay: --wait-for: no process is called planer (the names are simulator, "
+     "laser_driver, perception, tracking, planner, motor_bridge, router, record, run)"),
+    ("monitor --connect something not an endpoint",
+     lambda t: ["monitor", "--connect", "garbage"], 2,
+     "zenav monitor: argument --connect: 'garbage' is not a Zenoh endpoint: expected "
+     "PROTOCOL/ADDRESS, e.g. tcp/127.0.0.1:7447"),
+    ("up --connect something not an endpoint",
+     lambda t: ["up", "--run-dir", str(t / "run"), "--config",
+                str(REPO / "deploy" / "server.yaml"), "--connect", "garbage"], 2,
+     "zenav up: --connect: 'garbage' is not a Zenoh endpoint: expected PROTOCOL/ADDRESS, "
+     "e.g. tcp/127.0.0.1:7447"),
     ("run --planner foo",
      lambda t: ["run", str(SCENARIO), "--out", str(t / "o"), "--planner", "foo"], 2,
      f"zenav run: --planner 'foo': no such planner; choose from {', '.join(PLANNERS)}"),
@@ -156,7 +169,10 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
 def test_bad_input_is_one_line_and_a_status(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                             argv: Args, code: int, message: str) -> None:
     tmp = tmp_path.resolve()
-    status = zenav_main(argv(tmp))
+    try:
+        status = zenav_main(argv(tmp))
+    except SystemExit as stop:  # a usage error: argparse exits with its status
+        status = int(stop.code or 0)
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert status == code, captured.err

@@ -247,6 +247,8 @@ def test_the_screen_shows_path_map_and_the_view_round_the_robot():
 
 
 def test_a_map_scale_of_zero_is_refused_in_one_line(capsys):
-    assert zenav_main(["monitor", "--map-scale", "0"]) == 2
+    with pytest.raises(SystemExit) as refused:  # the parser refuses it
+        zenav_main(["monitor", "--map-scale", "0"])
+    assert refused.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["zenav monitor: --map-scale must be above 0 m, not 0"]
+    assert err == ["zenav monitor: argument --map-scale: must be > 0 (got 0)"]

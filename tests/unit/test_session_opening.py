@@ -40,7 +40,8 @@ def test_the_session_comes_out_open_and_is_the_callers() -> None:
 
 
 def test_an_error_from_zenoh_open_is_raised_where_the_session_is_awaited() -> None:
-    broken = TransportConfig(mode="peer", listen=["nonsense/127.0.0.1:1"])
+    # Built unchecked: TransportConfig itself refuses an endpoint Zenoh would not take.
+    broken = TransportConfig.model_construct(mode="peer", listen=["nonsense/127.0.0.1:1"])
     opening = runner.SessionOpening(broken)
     with pytest.raises(Exception, match="nonsense"):
         asyncio.run(opening.session())

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
+from zenav.argtypes import positive_float
 from zenav.bag.mcapfile import BagWriter
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
@@ -19,11 +19,25 @@ from zenav.tooling import (
     StampedSubscriber,
     add_connect_timeout,
     open_bus,
+    signal_status,
     stop_on_signals,
     tool_setup,
     wait_for_event,
 )
 from zenav.writable import PathError, check_output_file
+
+
+def recordable_topic(topic: str) -> str:
+    """A topic ``--exclude`` can name (``scan``, ``sim/truth``, ``status/planner``, ...);
+    ArgumentTypeError listing them otherwise."""
+    from zenav.schemas import keys
+
+    names = [t.name for t in keys.TOPICS]
+    service = topic.removeprefix(keys.STATUS.name + "/")  # status/SERVICE
+    if topic in names or (service != topic and service.replace("_", "").isalnum()):
+        return topic
+    raise argparse.ArgumentTypeError(f"no topic {topic!r}; the topics are {', '.join(names)} "
+                                     f"and {keys.STATUS.name}/SERVICE")
 
 
 async def record(transport: Any, robot_id: str, path: Path, *, duration: float | None,
@@ -82,18 +96,19 @@ def main(args: argparse.Namespace) -> int:
         return 2
     started = time.monotonic()
     try:
-        with contextlib.suppress(KeyboardInterrupt):
-            done = asyncio.run(record(transport, robot_id, args.file, duration=args.duration,
-                                      exclude=tuple(args.exclude),
-                                      connect_timeout=args.connect_timeout))
-            if done is None:
-                print("zenav record: stopped before the session opened; nothing recorded",
-                      file=sys.stderr)
-                return 0
-            count, changes = done
-            print(f"zenav record: {count} messages and {changes} liveliness changes in "
-                  f"{time.monotonic() - started:.1f} s -> {args.file} "
-                  f"({args.file.stat().st_size} B)", flush=True)
+        done = asyncio.run(record(transport, robot_id, args.file, duration=args.duration,
+                                  exclude=tuple(args.exclude),
+                                  connect_timeout=args.connect_timeout))
+        if done is None:
+            print("zenav record: stopped before the session opened; nothing recorded",
+                  file=sys.stderr)
+            return signal_status(0)
+        count, changes = done
+        print(f"zenav record: {count} messages and {changes} liveliness changes in "
+              f"{time.monotonic() - started:.1f} s -> {args.file} "
+              f"({args.file.stat().st_size} B)", flush=True)
+    except KeyboardInterrupt:
+        return 130
     except ConnectError as exc:
         print(f"zenav record: {exc}", file=sys.stderr)
         return 1
@@ -101,15 +116,16 @@ def main(args: argparse.Namespace) -> int:
         print(f"zenav record: {args.file}: cannot write ({exc.strerror or exc})",
               file=sys.stderr)
         return 2
-    return 0
+    return signal_status(0)  # 130 after SIGINT: the file is complete all the same
 
 
 
 def add_command(sub: Any) -> None:
     record = sub.add_parser("record", help="record every message of a robot to an MCAP file")
     record.add_argument("file", type=Path)
-    record.add_argument("--duration", type=float, help="stop after this many s")
-    record.add_argument("--exclude", action="append", default=[], metavar="TOPIC",
+    record.add_argument("--duration", type=positive_float, help="stop after this many s")
+    record.add_argument("--exclude", type=recordable_topic, action="append", default=[],
+                        metavar="TOPIC",
                         help="leave out a topic, e.g. sim/truth (repeatable)")
     add_transport_arguments(record)
     add_connect_timeout(record)

@@ -12,11 +12,13 @@ import xmlrpc.client
 from pathlib import Path
 from typing import Any
 
+from zenav.argtypes import positive_float
 from zenav.deploy.conf import default_run_dir, prepare, socket_path, standby_twins
 from zenav.deploy.model import DEFAULT_CONFIG, Deployment, load_deployment
 from zenav.deploy.rpc import Supervisor, unclean_stops
 from zenav.deploy.wait import check_started, expected_alive, wait_alive, wait_running
 from zenav.services.config import ConfigError
+from zenav.writable import PathError, check_output_dir
 
 DEFAULT_NAME = "stack"
 """The name of the default deployment (deploy/stack.yaml): ``zenav ctl`` and ``zenav down``
@@ -60,11 +62,19 @@ def cmd_up(args: argparse.Namespace) -> int:
     try:
         deployment, run_dir = _resolve(args)
         assert deployment is not None
+        try:  # before anything starts, --print too: one line, not a traceback
+            check_output_dir(run_dir)
+        except PathError as exc:
+            raise ConfigError(f"--run-dir {exc}") from None
         sup = Supervisor(run_dir)
         if (pid := sup.pid()) is not None:
             raise ConfigError(f"{deployment.name} is already up (supervisord pid {pid}, "
                               f"{run_dir}); zenav down first")
-        conf = prepare(deployment, run_dir)
+        try:
+            conf = prepare(deployment, run_dir)
+        except OSError as exc:
+            raise ConfigError(f"--run-dir {run_dir}: cannot write "
+                              f"{exc.filename or 'in it'} ({exc.strerror or exc})") from None
         if args.print:
             print(conf.read_text(), end="")
             return 0
@@ -200,9 +210,10 @@ def _add_common(parser: argparse.ArgumentParser) -> None:
 
 
 def add_commands(sub: Any) -> None:
-    up = sub.add_parser("up", help="start a deployment under supervisord (real time)",
-                        description="Start the deployment's programs under supervisord and "
-                        "wait until each is running and alive on the bus.")
+    up = sub.add_parser(
+        "up", help="start a deployment under supervisord (real time)",
+        description="Start the deployment's programs under supervisord and wait until each "
+        "is running and alive on the bus.")
     _add_common(up)
     up.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
                     help="the router the services join (replaces the file's endpoints)")
@@ -211,7 +222,7 @@ def add_commands(sub: Any) -> None:
     up.add_argument("--scenario", type=Path,
                     help="the simulator's scenario (replaces the deployment's; the "
                     "parameters that follow from it are derived from this one)")
-    up.add_argument("--timeout", type=float, default=30.0,
+    up.add_argument("--timeout", type=positive_float, default=30.0,
                     help="s to wait for the next program to run and to join the bus; "
                     "starts again at each one (default 30)")
     up.add_argument("--no-wait", action="store_true",

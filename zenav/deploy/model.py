@@ -20,7 +20,7 @@ from zenav.services.config import (
     read_yaml,
     resolve,
 )
-from zenav.services.transport import TransportConfig
+from zenav.services.transport import Endpoint, TransportConfig, check_endpoint
 from zenav.tooling import with_client_defaults
 
 DEFAULT_CONFIG = Path("deploy/stack.yaml")
@@ -50,8 +50,8 @@ class ProgramSpec(BaseModel):
 class RouterSpec(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    listen: list[str] = Field(default_factory=lambda: ["tcp/0.0.0.0:7447"])
-    connect: list[str] = Field(default_factory=list, description="other routers")
+    listen: list[Endpoint] = Field(default_factory=lambda: ["tcp/0.0.0.0:7447"])
+    connect: list[Endpoint] = Field(default_factory=list, description="other routers")
 
 
 class SupervisorSpec(BaseModel):
@@ -163,6 +163,11 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
     ``set``; ``connect`` replaces the transport's endpoints (the server side's router);
     ``scenario`` (relative to the working directory) replaces the file's scenario.
     """
+    for endpoint in connect or []:  # before anything else: no session would open
+        try:
+            check_endpoint(endpoint)
+        except ValueError as exc:
+            raise ConfigError(f"--connect: {exc}") from None
     data = read_yaml(path)
     if scenario is not None:
         data["scenario"] = str(scenario.resolve())
@@ -172,7 +177,7 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
         lines = []
         for error in exc.errors(include_url=False):
             where = ".".join(str(p) for p in error["loc"]) or "(top level)"
-            lines.append(f"{path}: {where}: {error['msg']}")
+            lines.append(f"{path}: {where}: {error['msg'].removeprefix('Value error, ')}")
         raise ConfigError("\n".join(lines)) from None
     base = path.resolve().parent
     if deployment.scenario is not None:

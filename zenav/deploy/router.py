@@ -28,7 +28,7 @@ from zenav.services.runner import (
     take_over,
     transport_from_args,
 )
-from zenav.services.transport import TransportConfig
+from zenav.services.transport import TransportConfig, check_endpoint
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +37,19 @@ DEFAULT_LISTEN = "tcp/0.0.0.0:7447"
 
 
 def router_transport(args: argparse.Namespace) -> TransportConfig:
-    if args.transport is None and not args.listen and not args.connect:
+    """The router's transport from its options; ConfigError with one line per problem (a
+    bad endpoint, a transport file that cannot be used)."""
+    for option in ("listen", "connect"):
+        for endpoint in getattr(args, option):
+            try:
+                check_endpoint(endpoint)
+            except ValueError as exc:
+                raise ConfigError(f"--{option}: {exc}") from None
+    if args.transport is not None:
+        from zenav.tooling import read_transport  # one line per problem, naming the field
+
+        config = read_transport(args.transport)
+    elif not args.listen and not args.connect:
         config = TransportConfig(mode="router", listen=[DEFAULT_LISTEN])
     else:
         config = transport_from_args(args, None)
@@ -63,7 +75,8 @@ def main(args: argparse.Namespace) -> int:
                              "or '-' (it becomes part of every key)")
         transport = router_transport(args)
     except (ConfigError, ValueError) as exc:
-        print(f"zenav router: {exc}", file=sys.stderr)
+        for line in str(exc).splitlines():  # one per problem
+            print(f"zenav router: {line}", file=sys.stderr)
         return 2
     stop = threading.Event()
 

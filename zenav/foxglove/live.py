@@ -17,6 +17,7 @@ from typing import Any
 import foxglove
 from foxglove import channels
 
+from zenav.argtypes import port, positive_float
 from zenav.foxglove.recording import SampleConverter
 from zenav.foxglove.scene import TOPICS
 from zenav.services.runner import add_transport_arguments
@@ -75,12 +76,30 @@ async def serve(transport: Any, robot_id: str, host: str, port: int,
         server.stop()
 
 
+def host_problem(host: str) -> str | None:
+    """Why the server cannot listen on ``host`` (a name that does not resolve), or None. An
+    address literal is taken as it is; a name is looked up as the server would."""
+    import ipaddress
+    import socket
+
+    try:
+        ipaddress.ip_address(host)
+        return None
+    except ValueError:
+        pass
+    try:
+        socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)
+    except (socket.gaierror, UnicodeError) as exc:
+        return f"--host {host!r}: not an address or a host name that resolves ({exc})"
+    return None
+
+
 def main(args: argparse.Namespace) -> int:
     setup = tool_setup(args, "foxglove")
     if setup is None:
         return 2
-    if not 0 <= args.port <= 65535:
-        print(f"zenav foxglove: --port {args.port} is not a TCP port", file=sys.stderr)
+    if (problem := host_problem(args.host)) is not None:
+        print(f"zenav foxglove: {problem}", file=sys.stderr)
         return 2
     robot_id, transport = setup
     # RuntimeError: the SDK's server could not bind its port
@@ -97,8 +116,8 @@ def add_command(sub: Any) -> None:
         "client from any host.")
     parser.add_argument("--host", default="127.0.0.1",
                         help="address to serve on (default 127.0.0.1; 0.0.0.0 for any host)")
-    parser.add_argument("--port", type=int, default=8765, help="WebSocket port (default 8765)")
-    parser.add_argument("--duration", type=float, help="stop after this many s")
+    parser.add_argument("--port", type=port, default=8765, help="WebSocket port (default 8765)")
+    parser.add_argument("--duration", type=positive_float, help="stop after this many s")
     add_transport_arguments(parser)
     add_connect_timeout(parser)
     parser.set_defaults(func=main)

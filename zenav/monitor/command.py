@@ -10,6 +10,7 @@ import sys
 import time
 from typing import IO, Any
 
+from zenav.argtypes import float_at_least, positive_float
 from zenav.monitor.model import MonitorModel
 from zenav.monitor.screen import render
 from zenav.services.runner import add_transport_arguments
@@ -23,6 +24,9 @@ from zenav.tooling import (
     tool_setup,
     wait_for_event,
 )
+
+MIN_PERIOD = 0.01
+"""The shortest ``--period``: 100 screens or snapshots a second."""
 
 
 async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
@@ -73,10 +77,6 @@ def main(args: argparse.Namespace) -> int:
     if setup is None:
         return 2
     robot_id, transport = setup
-    if not args.map_scale > 0:
-        print(f"zenav monitor: --map-scale must be above 0 m, not {args.map_scale:g}",
-              file=sys.stderr)
-        return 2
     return run_tool("monitor", monitor(transport, robot_id, jsonl=args.jsonl, period=args.period,
                                        duration=args.duration, silence=args.silence,
                                        scale=args.map_scale,
@@ -92,13 +92,14 @@ def add_command(sub: Any) -> None:
         "--connect ENDPOINT joins a router as a client from any host.")
     monitor.add_argument("--jsonl", action="store_true",
                          help="print events and snapshots as JSON lines, not a screen")
-    monitor.add_argument("--period", type=float, default=0.25,
-                         help="s between screen refreshes or snapshots (default 0.25)")
-    monitor.add_argument("--duration", type=float, help="stop after this many s")
-    monitor.add_argument("--silence", type=float, default=0.5,
+    monitor.add_argument("--period", type=float_at_least(MIN_PERIOD), default=0.25,
+                         help="s between screen refreshes or snapshots (default 0.25, at "
+                         f"least {MIN_PERIOD:g})")
+    monitor.add_argument("--duration", type=positive_float, help="stop after this many s")
+    monitor.add_argument("--silence", type=positive_float, default=0.5,
                          help="a topic silent this long (s, at least 4 typical gaps) counts "
                          "as stopped (default 0.5)")
-    monitor.add_argument("--map-scale", type=float, default=0.25, metavar="M",
+    monitor.add_argument("--map-scale", type=positive_float, default=0.25, metavar="M",
                          help="m of the world per column of the map view, rows twice that "
                          "(default 0.25: 41 x 21 characters cover about 10 x 10 m)")
     add_transport_arguments(monitor)
