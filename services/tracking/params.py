@@ -82,8 +82,9 @@ class TrackingParams(BaseModel):
         "view (a mover glimpsed at the edge of the view is not made a standing ghost)."
     )
     reacquire: float = Field(
-        6.0, ge=0.0, description="seconds: a track born where a mover lost within this "
-        "long is predicted to be (at its last velocity) is that mover seen again: it takes "
+        6.0, ge=0.0, description="seconds: a track born where a mover dropped beside or "
+        "behind the laser's field of view within this long is predicted to be (at its last "
+        "velocity) is that mover seen again: it takes "
         "back the mover's id, type and velocity instead of starting 'new' (a walker that "
         "left the view while the robot turned is not a new obstacle when it comes back); "
         "0: never.",

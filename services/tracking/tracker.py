@@ -404,22 +404,29 @@ class Tracker:
         if p.reacquire > 0.0:
             kept = set(live)
             self._lost = [t for t in self._lost if stamp - t.last_seen <= p.reacquire]
+            # Only a mover dropped beside or behind the laser's field of view: one lost
+            # in view (hidden by another, merged with it, or walked out of range) is not
+            # looked for, so a walker of a crowd is not taken for another that vanished
+            # near it (at 360 degrees nothing is looked for).
             self._lost += [t for ti, t in enumerate(self._tracks)
                            if ti not in kept and t.kind == "dynamic"
-                           and math.hypot(t.vx, t.vy) >= p.static_speed]
+                           and math.hypot(t.vx, t.vy) >= p.static_speed
+                           and not self._in_field(t, pose)]
         self._tracks = [self._tracks[ti] for ti in live]
         out.sort(key=lambda tr: tr.id)
         return out
 
+    def _in_field(self, t: _State, pose: Pose) -> bool:
+        """Whether the track's bearing from ``pose`` lies in the scanner's field of view."""
+        bearing = wrap_angle(math.atan2(t.y - pose[1], t.x - pose[0]) - pose[2])
+        return abs(bearing) <= math.radians(self.params.fov_deg) / 2
+
     def _in_view(self, t: _State, pose: Pose) -> bool:
         """Whether the scanner at ``pose`` could see the track's obstacle (ignoring
         occlusion): inside the field of view and the view range."""
-        dx, dy = t.x - pose[0], t.y - pose[1]
-        distance = math.hypot(dx, dy)
-        if distance - t.radius > self.params.window_radius:
+        if math.hypot(t.x - pose[0], t.y - pose[1]) - t.radius > self.params.window_radius:
             return False
-        bearing = wrap_angle(math.atan2(dy, dx) - pose[2])
-        return abs(bearing) <= math.radians(self.params.fov_deg) / 2
+        return self._in_field(t, pose)
 
     # --- association -------------------------------------------------------------------
 
