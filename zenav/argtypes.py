@@ -9,10 +9,13 @@ import argparse
 import math
 from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 __all__ = ["count", "float_at_least", "floats", "ints", "non_negative_float",
            "non_negative_int", "nonempty", "path", "port", "positive_float",
            "positive_float_at_most", "positive_int"]
+
+T = TypeVar("T")
 
 
 def path(text: str) -> Path:
@@ -98,24 +101,19 @@ def count(low: int, high: int) -> Callable[[str], int]:
 
 def floats(item: Callable[[str], float]) -> Callable[[str], tuple[float, ...]]:
     """A comma-separated list of at least one number, each checked by ``item``."""
-
-    def parse(text: str) -> tuple[float, ...]:
-        parts = [part.strip() for part in text.split(",") if part.strip()]
-        if not parts:
-            raise argparse.ArgumentTypeError(f"expected numbers separated by commas "
-                                             f"(got {text!r})")
-        return tuple(item(part) for part in parts)
-
-    return parse
+    return _listed(item, "numbers")
 
 
 def ints(item: Callable[[str], int]) -> Callable[[str], tuple[int, ...]]:
     """A comma-separated list of at least one whole number, each checked by ``item``."""
+    return _listed(item, "whole numbers")
 
-    def parse(text: str) -> tuple[int, ...]:
+
+def _listed(item: Callable[[str], T], what: str) -> Callable[[str], tuple[T, ...]]:
+    def parse(text: str) -> tuple[T, ...]:
         parts = [part.strip() for part in text.split(",") if part.strip()]
         if not parts:
-            raise argparse.ArgumentTypeError(f"expected whole numbers separated by commas "
+            raise argparse.ArgumentTypeError(f"expected {what} separated by commas "
                                              f"(got {text!r})")
         return tuple(item(part) for part in parts)
 

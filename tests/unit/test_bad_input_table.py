@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from tests.unit.clirun import status_of
 from zenav.bag.mcapfile import BagWriter
 from zenav.cli import main as zenav_main
 from zenav.schemas.codec import encode
@@ -169,10 +170,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
 def test_bad_input_is_one_line_and_a_status(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                             argv: Args, code: int, message: str) -> None:
     tmp = tmp_path.resolve()
-    try:
-        status = zenav_main(argv(tmp))
-    except SystemExit as stop:  # a usage error: argparse exits with its status
-        status = int(stop.code or 0)
+    status = status_of(argv(tmp))
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert status == code, captured.err

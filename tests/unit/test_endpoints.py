@@ -10,20 +10,11 @@ from pathlib import Path
 import pytest
 from pydantic import ValidationError
 
-from zenav.cli import main as zenav_main
+from tests.unit.clirun import zenav
 from zenav.services.transport import TransportConfig, check_endpoint
 
 REPO = Path(__file__).resolve().parents[2]
 SERVER = REPO / "deploy" / "server.yaml"
-
-
-def zenav(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, list[str]]:
-    """(exit status, stderr lines) of ``zenav argv``, argparse's refusals included."""
-    try:
-        code = zenav_main(argv)
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    return code, capsys.readouterr().err.splitlines()
 
 
 # --- endpoints ----------------------------------------------------------------------

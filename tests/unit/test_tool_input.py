@@ -18,22 +18,13 @@ from pathlib import Path
 
 import pytest
 
+from tests.unit.clirun import zenav
 from tests.unit.test_bad_input_table import a_bag
 from zenav import argtypes, tooling
-from zenav.cli import main as zenav_main
 from zenav.services.config import ConfigError
 
 REPO = Path(__file__).resolve().parents[2]
 NOBODY = "tcp/127.0.0.1:9"
-
-
-def zenav(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, list[str]]:
-    """(exit status, stderr lines) of ``zenav argv``, argparse's refusals included."""
-    try:
-        code = zenav_main(argv)
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    return code, capsys.readouterr().err.splitlines()
 
 
 # --- transport files ----------------------------------------------------------------
