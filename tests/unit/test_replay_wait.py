@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.unit.clirun import zenav
 from tests.unit.test_bad_input_table import a_bag
-from tests.unit.test_endpoints import zenav
 from zenav.bag.replay import WAITABLE, parse_wait_for, wait_alive
 from zenav.schemas.keys import Keys
 from zenav.services.transport import InMemoryBus
