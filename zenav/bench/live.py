@@ -140,9 +140,9 @@ def live_stack(scenario_path: Path, out_dir: Path, overrides: dict[str, dict[str
     for service, values in overrides.items():
         params.setdefault(service, {}).update(values)
     stack = Stack(out_dir=out_dir, params=params, log_level="WARNING")
-    stack.start()
     listener: Listener | None = None
-    try:
+    try:  # a start that fails half-way leaves no service running
+        stack.start()
         listener = Listener(stack, hops)
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:

@@ -180,8 +180,8 @@ def run_soak(out: Path, minutes: float, rate_hz: float, warmup: float = 30.0,
     params["simulator"] |= {"clock": "realtime", "realtime_factor": 1.0}
     params["motor_bridge"] |= {"clock": "realtime"}
     stack = Stack(out_dir=out, params=params, log_level="WARNING")
-    stack.start()
-    try:
+    try:  # a start that fails half-way leaves no service running
+        stack.start()
         report = asyncio.run(_soak(stack, seconds, warmup, min(window, seconds / 3), progress))
     finally:
         codes = stack.stop()
