@@ -33,7 +33,7 @@ from pydantic import (
 ObstacleKind = Literal["new", "static", "dynamic"]
 ScenarioLetter = Literal["a", "b", "c", "d", "e", "f", "g", "h"]
 Action = Literal["keep", "slow", "stop", "speed_up", "morphin", "resume", "goal", "safety_stop",
-                 "replan", "spin", "back_up", "wait", "unreachable"]
+                 "replan", "spin", "back_up", "wait", "unreachable", "give_way"]
 
 
 def _array_validator(dtype: str, ndim: int, width: int = 5) -> Any:

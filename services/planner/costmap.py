@@ -306,6 +306,16 @@ class Costmap:
         return np.asarray(self.occupied & self.known()
                           & (self.hit_since <= self.now - self.confirm))
 
+    def lethal_near(self, centre: Vec, radius: float) -> Vec:
+        """(n, 2) centres of the lethal cells within ``radius`` m of ``centre``."""
+        lo = np.maximum(self.cell_of((centre - radius)[None, :])[0], 0)
+        hi = np.minimum(self.cell_of((centre + radius)[None, :])[0] + 1, self.shape)
+        if (hi <= lo).any():
+            return np.empty((0, 2))
+        cells = np.argwhere(self.lethal()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
+        points = self.centre_of(cells)
+        return points[np.hypot(*(points - centre).T) <= radius]
+
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
         # Lethal cells change only with the grids and the time (decay, confirmation):
         # a cycle asks several times with neither changed.

@@ -38,7 +38,15 @@ from zenav.services.planner import safety
 from zenav.services.planner._loops import box_gaps
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
-from zenav.services.planner.follow import command_toward
+from zenav.services.planner.follow import backing_toward, command_toward
+from zenav.services.planner.give_way import (
+    Hold,
+    corridor_axis,
+    hemmed_in,
+    offsets,
+    passed,
+    spot_aside,
+)
 from zenav.services.planner.global_path import (
     GlobalPlan,
     arc_lengths,
@@ -165,6 +173,7 @@ class Planner:
         # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).
         self.last_seen_movers: dict[int, tuple[Obstacle, float]] = {}
         self.unseen: list[tuple[Obstacle, float]] = []  # (predicted to now, age s)
+        self.hold: Hold | None = None  # a spot aside held while a mover passes
         if self.start is not None:
             self._set_path(np.vstack([self.start, self.goal]), "start")
 
@@ -679,6 +688,12 @@ class Planner:
             threats.append(dataclasses.replace(base, letter="e", threat=True))
         if p.threats_per_cycle == "one" and threats:  # Algorithm 1: first in O_chain, break
             threats = [first_in_scan_order(threats, robot, pose[2])]
+        if self.hold is None and self._start_hold(robot, threats, in_window, stamp):
+            held = self.hold_aside(pose, obstacles, stamp)
+            if held is not None:
+                self.detour = None
+                self.commitments = {}
+                return held
         threat_ids = {a.obstacle.id for a in threats}
         self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}
 
@@ -826,11 +841,13 @@ class Planner:
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
         if decision is None:
-            decision = self.local_layer(pose, obstacles, stamp)
+            decision = (self.hold_aside(pose, obstacles, stamp)
+                        or self.local_layer(pose, obstacles, stamp))
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(decision, pose, scan)
-            waiting = decision.action in ("stop", "slow") and decision.kind == "dynamic"
+            waiting = (decision.action in ("stop", "slow", "give_way")
+                       and decision.kind == "dynamic")
             # Walled in: the goal is cut off by walls seen (the wall memory), so gains
             # along a path through forgotten walls are no progress: the steps follow one
             # another at once instead of after a stall (and progress does not reset them).
@@ -844,6 +861,7 @@ class Planner:
                     decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
                 else:
                     self.detour = None
+                    self.hold = None
                     decision = self.recover(pose, stamp, scan) or decision
         return self._record(decision)
 
@@ -855,6 +873,146 @@ class Planner:
         if not self.trail or math.dist(self.trail[-1], robot) >= 0.05:
             self.trail.append((float(robot[0]), float(robot[1])))
             del self.trail[:-400]
+
+    # -- stage: giving way in a corridor -----------------------------------------------
+
+    def _start_hold(self, robot: Vec, threats: list[Assessment], in_window: list[Obstacle],
+                    stamp: float) -> bool:
+        """Beyond the paper: when the one mover in the window comes head-on and threatens,
+        and the map holds walls on both sides of the robot (``give_way.hemmed_in``), pick
+        a spot aside (``give_way.spot_aside``: on the side of the mover's way the robot is
+        on, else the other) and hold it (``hold_aside``); whether one was found."""
+        p = self.p
+        if not (p.give_way and p.use_map) or self.costmap is None:
+            return False
+        movers = [o for o in in_window
+                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        if len(movers) != 1:
+            return False
+        mover = movers[0]
+        threat = next((a for a in threats if a.obstacle.id == mover.id), None)
+        if threat is None:
+            return False
+        velocity = np.asarray(mover.velocity, dtype=np.float64)
+        speed = float(np.hypot(*velocity))
+        if float(np.asarray(threat.direction) @ velocity) > p.head_on_cos * speed:
+            return False  # not head-on
+        axis = corridor_axis(self.costmap.lethal_near(robot, 2.0 * p.give_way_reach),
+                             p.map_resolution)
+        if axis is None or abs(float(axis @ velocity)) < -p.head_on_cos * speed:
+            return False  # no walls that run one way, or the mover does not walk along them
+        way = axis if float(axis @ velocity) > 0.0 else -axis
+        if not hemmed_in(robot, way, self.costmap.blocked_at, p.give_way_reach,
+                         p.map_resolution / 2):
+            return False
+        radius = max(mover.radius, p.robot_radius)
+        position = np.asarray(mover.position, dtype=np.float64)
+        near = 1 if offsets(robot[None, :], position, way)[0] >= 0.0 else -1
+        for side in (near, -near):
+            spot = self._spot_aside(robot, position, way, speed, radius, side)
+            if spot is not None:
+                self.hold = Hold(
+                    spot=(float(spot[0]), float(spot[1])), side=side, radius=radius,
+                    mover=mover.id, way=(float(way[0]), float(way[1])),
+                    until=stamp + p.give_way_limit, position=mover.position,
+                    velocity=mover.velocity, at=stamp, seen=stamp, moving=stamp)
+                return True
+        return False
+
+    def _spot_aside(self, robot: Vec, position: Vec, way: Vec, speed: float, radius: float,
+                    side: int) -> Vec | None:
+        """``give_way.spot_aside`` with the planner's map and parameters: a spot the mover
+        passes with the whole safety margin to spare where there is one, else half."""
+        assert self.costmap is not None
+        p = self.p
+        for margin in (p.safety_margin, p.safety_margin / 2):
+            spot = spot_aside(
+                robot, position, way, speed, p.robot_radius + radius + margin, side,
+                self.costmap.blocked_at, lambda a, b: self._disc_clear(self._leg(a, b)),
+                p.give_way_reach, p.map_resolution / 2, p.cruise_speed,
+                lead=(math.pi / 2) / p.max_omega)
+            if spot is not None:
+                return spot
+        return None
+
+    def hold_aside(self, pose: tuple[float, float, float], obstacles: list[Obstacle],
+                   stamp: float) -> Decision | None:
+        """The command of the spot aside under way: drive to it (backing, when it lies
+        behind: the way the robot came is known, and the mover stays in the laser's view),
+        then stand facing the mover; None once the hold ends: the mover has passed, has
+        been seen standing for ``give_way_patience`` s or not seen for ``mover_memory``
+        s, another mover has come into the window, or ``give_way_limit`` is up."""
+        hold = self.hold
+        if hold is None:
+            return None
+        p = self.p
+        where = hold.predicted(stamp)
+        reach = p.safety_growth * math.hypot(*hold.velocity) * (stamp - hold.at) + 0.5
+
+        def moving(o: Obstacle) -> bool:
+            return o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed
+
+        track = next((o for o in obstacles if o.id == hold.mover), None)
+        if track is None:  # tracked again under another id, where it is predicted
+            track = next((o for o in obstacles if moving(o)
+                          and math.dist(o.position, where) <= reach + o.radius), None)
+        if track is not None:
+            hold.mover, hold.at, hold.seen = track.id, stamp, stamp
+            if track.radius >= 0.7 * hold.radius:
+                hold.position = track.position
+            else:
+                # A track of part of the mover (its cluster split or merged with a wall's
+                # as it passes near one) says how far it has come, not where across the
+                # corridor it walks: that stays as last seen whole.
+                hold.position = hold.along(track.position)
+            hold.radius = max(hold.radius, track.radius)
+            if moving(track):
+                hold.velocity, hold.moving = track.velocity, stamp
+        else:  # out of view (beside or behind the robot): where it is predicted
+            hold.position, hold.at = (float(where[0]), float(where[1])), stamp
+        others = [o for o in obstacles if o.id != hold.mover and moving(o)
+                  and math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+        clearance = p.robot_radius + hold.radius + p.safety_margin / 2
+        robot = np.array(pose[:2], dtype=np.float64)
+        standing = track is not None and stamp - hold.moving > p.give_way_patience
+        lost = stamp - hold.seen > max(p.mover_memory, p.give_way_patience)
+        if (stamp > hold.until or others or standing or lost
+                or passed(robot, np.asarray(hold.position, dtype=np.float64),
+                          np.asarray(hold.way, dtype=np.float64), clearance)):
+            self.hold = None
+            return None
+        # The mover's place is known better as it comes: a spot it would now pass
+        # touching (the margin used up; a track's centre errs by centimetres toward the
+        # side it is seen from) is looked for again, on the same side.
+        position = np.asarray(hold.position, dtype=np.float64)
+        way = np.asarray(hold.way, dtype=np.float64)
+        spot = np.asarray(hold.spot, dtype=np.float64)
+        if offsets(spot[None, :], position, way)[0] * hold.side < p.robot_radius + hold.radius:
+            better = self._spot_aside(robot, position, way, math.hypot(*hold.velocity),
+                                      hold.radius, hold.side)
+            if better is not None:
+                hold.spot = (float(better[0]), float(better[1]))
+        hold.reached = hold.reached or math.dist(pose[:2], hold.spot) <= p.subtarget_reached / 3
+        if not hold.reached:
+            target, speed = hold.spot, p.cruise_speed
+            bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
+            drive = backing_toward if math.cos(bearing - pose[2]) < 0.0 else command_toward
+        else:
+            # Keep to this side of the mover's line and go on along it while the map
+            # leaves the lane free a look-ahead on; else stand there, facing the mover.
+            on_lane = spot + float((robot - spot) @ way) * way
+            ahead = on_lane - p.lookahead * way
+            lane = path_points(on_lane, -way, p.lookahead, p.map_resolution / 2)
+            if not self.costmap.blocked_at(lane).any():
+                target, speed = (float(ahead[0]), float(ahead[1])), p.cruise_speed
+                along = math.atan2(-way[1], -way[0])
+                if abs(wrap_angle(along - pose[2])) > math.radians(p.safety_fan_deg):
+                    speed = 0.0  # square to the lane first: turning on the move drifts
+            else:
+                target, speed = hold.position, 0.0
+            drive = command_toward
+        v, omega = drive(pose[0], pose[1], pose[2], target, speed, p.heading_gain, p.max_omega)
+        return Decision(v, omega, target, "f", "give_way", hold.mover, "dynamic", speed)
 
     # -- the movers out of view --------------------------------------------------------
 

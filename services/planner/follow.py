@@ -30,3 +30,18 @@ def command_toward(
     omega = max(-max_omega, min(max_omega, heading_gain * error))
     v = min(speed, distance) * max(0.0, math.cos(error))
     return v, omega
+
+
+def backing_toward(
+    x: float,
+    y: float,
+    heading: float,
+    target: tuple[float, float],
+    speed: float,
+    heading_gain: float,
+    max_omega: float,
+) -> tuple[float, float]:
+    """(v, omega) that backs toward ``target`` at up to ``speed`` m/s: the rear turned
+    toward it as ``command_toward`` turns the front, v negative."""
+    v, omega = command_toward(x, y, heading + math.pi, target, speed, heading_gain, max_omega)
+    return -v, omega

@@ -264,6 +264,25 @@ class Params(MissionParams, StopZoneParams):
         "run back to back), before the goal is declared unreachable"
     )
 
+    # --- giving way (give_way.py) -----------------------------------------------------
+    give_way: bool = Field(
+        True, description="beyond the paper: between walls (the map holds something within "
+        "give_way_reach on both sides of the robot), step aside from the one mover coming "
+        "head-on and wait, facing it, until it has passed, instead of a detour that turns "
+        "back along the corridor (needs use_map)"
+    )
+    give_way_reach: float = Field(
+        1.5, gt=0, description="how far the spot aside may be, and how far to each side "
+        "the map is looked at for walls, m"
+    )
+    give_way_limit: float = Field(
+        60.0, gt=0, description="longest a spot aside is held, s"
+    )
+    give_way_patience: float = Field(
+        3.0, gt=0, description="a spot aside is given up when the mover has not been seen, "
+        "or not seen moving, for this long, s"
+    )
+
     def effective_progress_timeout(self) -> float:
         if self.progress_timeout is not None:
             return self.progress_timeout

@@ -52,6 +52,7 @@ def ground_truth_clearance(path: Path, trajectory: list[list[float]]) -> float:
 def test_there_is_a_scenario_for_every_class():
     names = {p.stem for p in SCENARIOS}
     for needed in ("appear", "wall-gap", "dead-end", "corridor-follower", "corridor-head-on",
+                   "corridor-sealed-head-on",
                    "posts", "mover-stops", "facing-away"):
         assert any(needed in name for name in names), needed
 
@@ -71,3 +72,11 @@ def test_the_appearing_box_is_never_taken_for_a_mover(records):
     events = records["nav-appear-ahead"]["events"]
     assert all(e["kind"] != "dynamic" for e in events), events
     assert any(e["scenario"] == "b" and e["action"] == "morphin" for e in events)
+
+
+def test_in_a_sealed_corridor_the_robot_gives_way(records):
+    """No way round the head-on walker: the robot steps aside (a `give_way` event about
+    it, typed dynamic) instead of a detour back along the corridor, and is not hit."""
+    events = records["nav-corridor-sealed-head-on"]["events"]
+    held = [e for e in events if e["action"] == "give_way"]
+    assert held and all(e["kind"] == "dynamic" and e["scenario"] == "f" for e in held), events
