@@ -314,7 +314,8 @@ class Costmap:
             return np.empty((0, 2))
         cells = np.argwhere(self.lethal()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
         points = self.centre_of(cells)
-        return points[np.hypot(*(points - centre).T) <= radius]
+        near: Vec = points[np.hypot(*(points - centre).T) <= radius]
+        return near
 
     def _refresh(self) -> tuple[BoolGrid, BoolGrid]:
         # Lethal cells change only with the grids and the time (decay, confirmation):

@@ -689,11 +689,11 @@ class Planner:
         if p.threats_per_cycle == "one" and threats:  # Algorithm 1: first in O_chain, break
             threats = [first_in_scan_order(threats, robot, pose[2])]
         if self.hold is None and self._start_hold(robot, threats, in_window, stamp):
-            held = self.hold_aside(pose, obstacles, stamp)
-            if held is not None:
+            aside = self.hold_aside(pose, obstacles, stamp)
+            if aside is not None:
                 self.detour = None
                 self.commitments = {}
-                return held
+                return aside
         threat_ids = {a.obstacle.id for a in threats}
         self.commitments = {i: c for i, c in self.commitments.items() if i in threat_ids}
 
@@ -1003,6 +1003,7 @@ class Planner:
             on_lane = spot + float((robot - spot) @ way) * way
             ahead = on_lane - p.lookahead * way
             lane = path_points(on_lane, -way, p.lookahead, p.map_resolution / 2)
+            assert self.costmap is not None  # a hold starts only on a map
             if not self.costmap.blocked_at(lane).any():
                 target, speed = (float(ahead[0]), float(ahead[1])), p.cruise_speed
                 along = math.atan2(-way[1], -way[0])
