@@ -905,7 +905,7 @@ class Planner:
         if not hemmed_in(robot, way, self.costmap.blocked_at, p.give_way_reach,
                          p.map_resolution / 2):
             return False
-        radius = max(mover.radius, p.robot_radius)
+        radius = max(mover.radius, p.robot_radius)  # a track of part of it is smaller
         position = np.asarray(mover.position, dtype=np.float64)
         near = 1 if offsets(robot[None, :], position, way)[0] >= 0.0 else -1
         for side in (near, -near):
@@ -939,7 +939,8 @@ class Planner:
                    stamp: float) -> Decision | None:
         """The command of the spot aside under way: drive to it (backing, when it lies
         behind: the way the robot came is known, and the mover stays in the laser's view),
-        then stand facing the mover; None once the hold ends: the mover has passed, has
+        then keep to that lane, on along it while the map leaves it free, else standing
+        facing the mover; None once the hold ends: the mover has passed, has
         been seen standing for ``give_way_patience`` s or not seen for ``mover_memory``
         s, another mover has come into the window, or ``give_way_limit`` is up."""
         hold = self.hold
@@ -992,6 +993,7 @@ class Planner:
                                       hold.radius, hold.side)
             if better is not None:
                 hold.spot = (float(better[0]), float(better[1]))
+        spot = np.asarray(hold.spot, dtype=np.float64)
         hold.reached = hold.reached or math.dist(pose[:2], hold.spot) <= p.subtarget_reached / 3
         if not hold.reached:
             target, speed = hold.spot, p.cruise_speed
