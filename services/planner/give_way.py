@@ -4,7 +4,7 @@ Beyond the paper. The paper answers a head-on mover (f) with a Morphin detour ro
 Between two walls there is no way round: the detours turn back along the corridor, the
 robot drives away from the mover at its own (lower) speed, turns its back on it and
 loses it from the 180-degree laser, and the mover walks into it. A person in a corridor
-steps aside and waits. This module finds where:
+steps aside and lets it by. This module finds where:
 
 - :func:`hemmed_in`: the map holds something within reach on both sides of the robot,
   square to the mover's way (a corridor, a doorway): the only case where the robot
@@ -19,8 +19,9 @@ steps aside and waits. This module finds where:
 - :func:`passed`: the mover is behind the robot along its own way, clear by the
   clearance: the robot may go on.
 
-The planner holds the spot, facing the mover so the laser keeps it in view, until the
-mover has passed (``Planner.hold_aside``).
+The planner holds the spot, then keeps to that lane (on along it while the map leaves it
+free, else standing facing the mover so the laser keeps it in view) until the mover has
+passed (``Planner.hold_aside``).
 """
 
 from __future__ import annotations
