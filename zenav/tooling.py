@@ -80,6 +80,8 @@ def read_transport(path: Path) -> TransportConfig:
     the field, when one is wrong)."""
     import yaml
 
+    from zenav.services.inputs import AliasError, safe_load
+
     try:
         text = path.read_text()
     except OSError as exc:
@@ -87,7 +89,9 @@ def read_transport(path: Path) -> TransportConfig:
     except UnicodeDecodeError:
         raise ConfigError(f"{path}: not a text file") from None
     try:
-        data = yaml.safe_load(text)
+        data = safe_load(text)  # the bounded loader every input file goes through
+    except AliasError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
     except yaml.YAMLError as exc:
         raise ConfigError(f"{path}: not valid YAML ({yaml_problem(exc)})") from None
     if data is None:

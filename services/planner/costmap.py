@@ -312,7 +312,7 @@ class Costmap:
         hi = np.minimum(self.cell_of((centre + radius)[None, :])[0] + 1, self.shape)
         if (hi <= lo).any():
             return np.empty((0, 2))
-        cells = np.argwhere(self.lethal()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
+        cells = np.argwhere(self.lethal_grid()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
         points = self.centre_of(cells)
         near: Vec = points[np.hypot(*(points - centre).T) <= radius]
         return near

@@ -282,8 +282,7 @@ class Planner:
         return lows, highs
 
     def _statics(self, obstacles: list[Obstacle]) -> list[Obstacle]:
-        return [o for o in obstacles
-                if o.kind != "dynamic" or math.hypot(*o.velocity) < self.p.moving_speed]
+        return [o for o in obstacles if not self._moving(o)]
 
     def _assess_all(
         self, robot: Vec, target: Vec, obstacles: list[Obstacle], extra_margin: float,
@@ -745,8 +744,7 @@ class Planner:
 
         unseen = [(o, age) for o, age in self.unseen
                   if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
-        movers = [o for o in in_window
-                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        movers = [o for o in in_window if self._moving(o)]
         # Every track typed dynamic, standing ones too: their returns are not in the map.
         # Then the movers out of view, predicted from where they were last seen.
         walkers = [o for o in in_window if o.kind == "dynamic"] + [o for o, _ in unseen]
@@ -874,6 +872,10 @@ class Planner:
             self.trail.append((float(robot[0]), float(robot[1])))
             del self.trail[:-400]
 
+    def _moving(self, o: Obstacle) -> bool:
+        """Whether ``o`` is a mover: typed dynamic and at least ``moving_speed`` fast."""
+        return o.kind == "dynamic" and math.hypot(*o.velocity) >= self.p.moving_speed
+
     # -- stage: giving way in a corridor -----------------------------------------------
 
     def _start_hold(self, robot: Vec, threats: list[Assessment], in_window: list[Obstacle],
@@ -885,8 +887,7 @@ class Planner:
         p = self.p
         if not (p.give_way and p.use_map) or self.costmap is None:
             return False
-        movers = [o for o in in_window
-                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        movers = [o for o in in_window if self._moving(o)]
         if len(movers) != 1:
             return False
         mover = movers[0]
@@ -950,12 +951,9 @@ class Planner:
         where = hold.predicted(stamp)
         reach = p.safety_growth * math.hypot(*hold.velocity) * (stamp - hold.at) + 0.5
 
-        def moving(o: Obstacle) -> bool:
-            return o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed
-
         track = next((o for o in obstacles if o.id == hold.mover), None)
         if track is None:  # tracked again under another id, where it is predicted
-            track = next((o for o in obstacles if moving(o)
+            track = next((o for o in obstacles if self._moving(o)
                           and math.dist(o.position, where) <= reach + o.radius), None)
         if track is not None:
             hold.mover, hold.at, hold.seen = track.id, stamp, stamp
@@ -967,11 +965,11 @@ class Planner:
                 # corridor it walks: that stays as last seen whole.
                 hold.position = hold.along(track.position)
             hold.radius = max(hold.radius, track.radius)
-            if moving(track):
+            if self._moving(track):
                 hold.velocity, hold.moving = track.velocity, stamp
         else:  # out of view (beside or behind the robot): where it is predicted
             hold.position, hold.at = (float(where[0]), float(where[1])), stamp
-        others = [o for o in obstacles if o.id != hold.mover and moving(o)
+        others = [o for o in obstacles if o.id != hold.mover and self._moving(o)
                   and math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
         clearance = p.robot_radius + hold.radius + p.safety_margin / 2
         robot = np.array(pose[:2], dtype=np.float64)
@@ -987,8 +985,8 @@ class Planner:
         # side it is seen from) is looked for again, on the same side.
         position = np.asarray(hold.position, dtype=np.float64)
         way = np.asarray(hold.way, dtype=np.float64)
-        spot = np.asarray(hold.spot, dtype=np.float64)
-        if offsets(spot[None, :], position, way)[0] * hold.side < p.robot_radius + hold.radius:
+        held = np.asarray(hold.spot, dtype=np.float64)[None, :]
+        if offsets(held, position, way)[0] * hold.side < p.robot_radius + hold.radius:
             better = self._spot_aside(robot, position, way, math.hypot(*hold.velocity),
                                       hold.radius, hold.side)
             if better is not None:
@@ -1028,8 +1026,7 @@ class Planner:
         should see it where it is predicted and does not, or when a mover tracked now is
         where it is predicted (seen again, under a new track)."""
         p = self.p
-        moving = [o for o in obstacles
-                  if o.kind == "dynamic" and math.hypot(*o.velocity) >= p.moving_speed]
+        moving = [o for o in obstacles if self._moving(o)]
         live = {o.id for o in obstacles}
         for ob in moving:
             self.last_seen_movers[ob.id] = (ob, stamp)
