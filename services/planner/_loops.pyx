@@ -197,16 +197,21 @@ def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, do
 
 
 def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
-                 const double[::1] hit_since, double known_from, double confirmed_by,
-                 const unsigned char[::1] before, unsigned char[::1] out):
+                 const double[::1] hit_since, const unsigned char[::1] walls,
+                 double known_from, double confirmed_by, double wall_known_from,
+                 double wall_confirm, const unsigned char[::1] before,
+                 unsigned char[::1] out):
     """Into ``out`` (one byte a cell of the flat grids) the lethal cells of
     ``Costmap.lethal``: occupied, seen at ``known_from`` or later, and occupied since
-    ``confirmed_by`` or earlier (the same comparisons: a nan is neither); whether they
-    differ from ``before`` (a grid of the same size, the last lethal cells)."""
+    ``confirmed_by`` or earlier; or a wall seen at ``wall_known_from`` or later (the
+    same comparisons: a nan is neither); whether they differ from ``before`` (a grid of
+    the same size, the last lethal cells)."""
     cdef Py_ssize_t c
     cdef unsigned char flag, changed = 0
     for c in range(occupied.shape[0]):
-        flag = (occupied[c] != 0) & (seen[c] >= known_from) & (hit_since[c] <= confirmed_by)
+        flag = ((occupied[c] != 0) & (seen[c] >= known_from) & (hit_since[c] <= confirmed_by)
+                | (walls[c] != 0) & (seen[c] >= wall_known_from)
+                & (seen[c] - hit_since[c] >= wall_confirm))
         out[c] = flag
         changed |= flag != before[c]
     return changed != 0

@@ -12,6 +12,14 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   beyond perception's window (no track, no type) leaves no wake of marks: its front moves
   on to new cells before they are confirmed, and the beams clear the cells it left;
 - a cell keeps what it was last seen as for ``decay`` seconds, then is unknown again;
+  except a wall of the memory (below) whose returns came for ``wall_confirm`` seconds
+  or more: it stays an obstacle for ``wall_decay`` seconds since it was last seen, and
+  recovery's clearing keeps it, unless a beam passes through it first (Nav2's obstacle
+  layer keeps its marks until a beam clears them). With the short decay alone, the
+  walls of a long corridor or a maze were forgotten behind the robot, and the path went
+  back through them. A slow walker far down a corridor, beyond perception's window,
+  left marks confirmed as walls that, kept, closed a sealed corridor ahead of the
+  robot; their returns had not come for ``wall_confirm``, so they decay and are cleared;
 - the planner treats unknown cells as free (optimistic, as Nav2's ``allow_unknown``), but
   not the space beyond the grid: the global path never leaves it (the grid holds start,
   goal, the robot and every return with half the padding to spare; only ``max_size``
@@ -20,9 +28,10 @@ Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
   disc of cells stamped, or with many of them scipy.ndimage's Euclidean distance
   transform: the same cells), so a path through the free cells keeps the robot's disc
   clear of everything the map holds;
-- apart from the map the path is planned on, a wall memory keeps every confirmed
-  obstacle cell until a beam passes through it (no decay, no recovery clearing):
-  ``cut_off`` asks it whether the walls ever seen close the goal off from the robot.
+- the wall memory keeps every confirmed obstacle cell until a beam passes through it
+  (no decay, no recovery clearing): the map's lethal cells include its long-seen walls
+  (above), and ``cut_off`` asks all of it, with no time limit, whether the walls ever
+  seen close the goal off from the robot.
   The decaying map alone cannot say so: at 0.1 m/s going round a ring of walls takes
   longer than ``decay``, so the side seen first is unknown (free) again by the time the
   last is seen, and a way "opens" there on every round.
@@ -109,11 +118,15 @@ class Costmap:
         decay: float,
         inflation: float,
         confirm: float = 0.0,
+        wall_decay: float | None = None,
+        wall_confirm: float = 0.0,
         padding: float,
         max_size: float,
     ) -> None:
         self.resolution = resolution
         self.decay = decay
+        self.wall_decay = decay if wall_decay is None else max(wall_decay, decay)
+        self.wall_confirm = wall_confirm
         self.confirm = confirm
         self.inflation = inflation
         self.padding = padding
@@ -247,9 +260,10 @@ class Costmap:
 
     def forget_older_than(self, stamp: float, keep: tuple[Vec, float] | None = None) -> None:
         """Make every cell last seen before ``stamp`` unknown (recovery's clearing),
-        except, with ``keep`` (a point and a radius, m), the cells whose centre lies within
-        the radius of the point (Nav2's clearing except a region round the robot)."""
-        old = self.seen < stamp
+        except the long-seen walls (``_kept_walls``) and, with ``keep`` (a point and a
+        radius, m), the cells whose centre lies within the radius of the point (Nav2's
+        clearing except a region round the robot)."""
+        old = (self.seen < stamp) & ~self._kept_walls()
         if keep is not None:
             nx, ny = self.shape
             i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
@@ -302,9 +316,48 @@ class Costmap:
 
     def lethal(self) -> BoolGrid:
         """Cells occupied when last seen, within the decay time, and for at least the
-        confirmation time."""
+        confirmation time; and the long-seen walls (``_kept_walls``)."""
         return np.asarray(self.occupied & self.known()
-                          & (self.hit_since <= self.now - self.confirm))
+                          & (self.hit_since <= self.now - self.confirm)
+                          | self._kept_walls())
+
+    def _returns_in(self, lo: Vec, hi: Vec) -> tuple[npt.NDArray[np.int64], tuple[slice, slice]]:
+        """The first cell of the part of the grid the box ``lo``..``hi`` (m) covers, and
+        that part's slices (empty when the box misses the grid)."""
+        first = np.maximum(self.cell_of(lo[None, :])[0], 0)
+        last = np.maximum(np.minimum(self.cell_of(hi[None, :])[0] + 1, self.shape), first)
+        return first, (slice(int(first[0]), int(last[0])), slice(int(first[1]), int(last[1])))
+
+    def has_returns_in(self, lo: Vec, hi: Vec) -> bool:
+        """Whether a cell inside the box ``lo``..``hi`` (m) was occupied when last seen,
+        within the decay time (a return, confirmed as lethal or not yet)."""
+        _, part = self._returns_in(lo, hi)
+        return bool((self.occupied[part] & (self.seen[part] >= self.now - self.decay)).any())
+
+    def _kept_walls(self) -> BoolGrid:
+        """The walls kept past the decay and through recovery's clearing: seen within
+        the wall decay time, occupied for at least the wall confirmation time then."""
+        return np.asarray(self.walls & (self.seen >= self.now - self.wall_decay)
+                          & (self.seen - self.hit_since >= self.wall_confirm))
+
+    def returns_near_segment(self, a: Vec, b: Vec, distance: float,
+                             lo: Vec | None = None, hi: Vec | None = None) -> bool:
+        """Whether a cell occupied when last seen, within the decay time (a return,
+        confirmed as lethal or not yet), has its centre within ``distance`` m of the
+        segment from ``a`` to ``b``; with ``lo`` and ``hi`` (m), only the cells inside
+        that box count."""
+        if lo is None or hi is None:
+            lo, hi = np.minimum(a, b) - distance, np.maximum(a, b) + distance
+        first, part = self._returns_in(lo, hi)
+        cells = np.argwhere(self.occupied[part] & (self.seen[part] >= self.now - self.decay))
+        if len(cells) == 0:
+            return False
+        rel = self.centre_of(cells + first) - a
+        offset = b - a
+        length2 = float(offset @ offset)
+        t = np.clip(rel @ offset / length2, 0.0, 1.0) if length2 > 0 else np.zeros(len(rel))
+        gaps = np.hypot(*(rel - t[:, None] * offset[None, :]).T)
+        return bool((gaps <= distance).any())
 
     def lethal_near(self, centre: Vec, radius: float) -> Vec:
         """(n, 2) centres of the lethal cells within ``radius`` m of ``centre``."""
@@ -332,7 +385,9 @@ class Costmap:
             before = None
         changed = lethal_cells(
             _flat(self.occupied).view(np.uint8), _flat(self.seen), _flat(self.hit_since),
-            self.now - self.decay, self.now - self.confirm,
+            _flat(self.walls).view(np.uint8),
+            self.now - self.decay, self.now - self.confirm, self.now - self.wall_decay,
+            self.wall_confirm,
             _flat(lethal if before is None else before).view(np.uint8),
             _flat(lethal).view(np.uint8))
         if self._inflated is not None and before is not None and not changed:

@@ -214,6 +214,8 @@ class Planner:
         rejoin = self._rejoin_point(robot, statics)
         if rejoin is None or project(self.path, rejoin, lengths)[0] < s0 + p.lookahead:
             return default
+        if not self._chord_clear(robot, rejoin):
+            return default  # clear of the boxes, not of what the map holds
         return rejoin
 
     def _to_goal(self, robot: Vec, lows: Vec, highs: Vec) -> Callable[[Vec], float]:
@@ -296,10 +298,7 @@ class Planner:
         if distance < 1e-9:
             return []
         direction = offset / distance
-        length = distance
-        if to_goal:  # along the global path the robot goes on past the look-ahead point
-            length = max(distance, min(self._straight_ahead(robot, direction),
-                                       self.p.window_radius))
+        length = self._way_length(robot, direction, distance, to_goal)
         p = self.p
         held = [self.commitments.get(ob.id) for ob in obstacles]
         return assess_all(
@@ -311,6 +310,15 @@ class Planner:
             following=[c is not None and c.letter == "g" for c in held],
             robot_radius=p.robot_radius, cell=p.cell, moving_speed=p.moving_speed,
             head_on_cos=p.head_on_cos, same_way_cos=p.same_way_cos, meet_rule=p.meet_rule)
+
+    def _way_length(self, robot: Vec, direction: Vec, distance: float, to_goal: bool) -> float:
+        """How far along ``direction`` the way to a target ``distance`` m off is judged:
+        to the target; toward the path's look-ahead point (``to_goal``), on as far as the
+        path runs straight, within the window (the robot goes on past the point)."""
+        if not to_goal:
+            return distance
+        ahead: float = min(self._straight_ahead(robot, direction), self.p.window_radius)
+        return max(distance, ahead)
 
     def _straight_ahead(self, robot: Vec, direction: Vec) -> float:
         """How far the global path runs on from the robot in ``direction`` before it
@@ -337,8 +345,11 @@ class Planner:
         distance = float(np.hypot(*offset))
         if distance <= self.p.map_resolution:
             return True
-        return not self._blocked_along(robot, offset / distance, self.p.map_resolution,
-                                       distance)
+        if self._blocked_along(robot, offset / distance, self.p.map_resolution, distance):
+            return False
+        # The returns not yet confirmed as lethal count too: round a bend, the inner
+        # corner is seen a moment before the chord to the look-ahead point cuts it.
+        return not self.costmap.returns_near_segment(robot, point, self.costmap.inflation)
 
     def _blocked_along(self, robot: Vec, direction: Vec, first: float, length: float) -> bool:
         """Whether the map blocks any of the points every half map cell from ``first`` to
@@ -350,13 +361,37 @@ class Planner:
             (rx + dx * first, ry + dy * first), (dx, dy), length - first,
             path_count(length - first, self.p.map_resolution / 2))
 
-    def _threats(self, notes: list[Assessment], clear: bool, stamp: float
-                 ) -> list[Assessment]:
+    def _threats(self, notes: list[Assessment], clear: bool, stamp: float, robot: Vec,
+                 target: Vec, to_goal: bool) -> list[Assessment]:
         """The assessments to answer: threats of a known type, confirmed, and not a (b)
-        on an obstacle the map holds while the map finds the way clear (``clear``)."""
+        while the map finds the way to ``target`` clear (``clear``) on an obstacle the
+        map holds, or on one too young for the map whose returns all keep off the way."""
         return [self._sticky(a) for a in notes
                 if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
-                and not (a.letter == "b" and clear and self._mapped(a, stamp))]
+                and not (a.letter == "b" and clear
+                         and (self._mapped(a, stamp)
+                              or self._returns_off_the_way(a, robot, target, to_goal)))]
+
+    def _returns_off_the_way(self, a: Assessment, robot: Vec, target: Vec,
+                             to_goal: bool) -> bool:
+        """Beyond the paper: whether the map's returns inside a standing obstacle's cell
+        box S_k (marked at once, though confirmed as lethal only after ``map_confirm``)
+        all keep the inflation distance off the straight way the (b) test judged. The
+        box of a wall's corner first seen round a bend (an L of returns) covers the free
+        inside of the bend, and answering it with a detour turned the robot back at a
+        corridor's turn. False when the box holds no return: the box decides, as in the
+        paper."""
+        if self.costmap is None:
+            return False
+        lo, hi = cell_squares(a.obstacle.cells, self.p.cell)
+        offset = target - robot
+        distance = float(np.hypot(*offset))
+        if distance < 1e-9 or not self.costmap.has_returns_in(lo, hi):
+            return False
+        direction = offset / distance
+        end = robot + direction * self._way_length(robot, direction, distance, to_goal)
+        return not self.costmap.returns_near_segment(robot, end, self.costmap.inflation,
+                                                     lo, hi)
 
     def _mapped(self, a: Assessment, stamp: float) -> bool:
         """Whether a standing obstacle has been seen long enough to be in the map, and
@@ -396,10 +431,7 @@ class Planner:
         if distance < 1e-9:
             return True
         direction = offset / distance
-        length = distance
-        if to_goal:
-            length = max(distance, min(self._straight_ahead(robot, direction),
-                                       self.p.window_radius))
+        length = self._way_length(robot, direction, distance, to_goal)
         if not self._blocked_along(robot, direction, min(self.p.map_resolution, length),
                                    length):
             return True
@@ -433,6 +465,21 @@ class Planner:
         return path_points(robot, offset / max(distance, 1e-9), distance,
                            self.p.map_resolution / 2)
 
+    def _crosses_map(self, points: Vec) -> bool:
+        """Beyond the paper: whether the robot's disc, centred on each of ``points`` (its
+        position first), would cover an occupied cell's centre of the map, deeper than
+        it does where it stands. A Morphin candidate is checked on the obstacles' cell
+        boxes S_k, and a box round an L-shaped wall, or one the robot stands inside,
+        lets a candidate through the wall itself: at a corridor's turn the sub-target
+        fell behind the inner wall, though the global path went round it."""
+        assert self.costmap is not None
+        cells = self.costmap.cell_of(points)
+        inside = self.costmap.inside(cells)
+        gap = np.full(len(points), math.inf)
+        gap[inside] = self.costmap.gap()[cells[inside, 0], cells[inside, 1]]
+        need = min(self.p.robot_radius, float(gap[0])) - 1e-6
+        return bool((gap < need).any())
+
     def _disc_clear(self, points: Vec) -> bool:
         """Whether the robot's disc, centred on each of ``points``, covers no occupied
         cell's centre of the map."""
@@ -460,9 +507,10 @@ class Planner:
         mapped = [a for a in threats if a.letter == "b" and self._mapped(a, stamp)]
         if not mapped or self._path_passable(robot, path_target):
             return False
-        sides = dict(self.sides)  # a trial: the side it picks is not kept
+        # A trial of the paper's detour, on the boxes alone: the side it picks is not kept.
+        sides = dict(self.sides)
         trial = self.plan_detour(robot, min(mapped, key=lambda a: a.robot_distance),
-                                 obstacles, fast=False)
+                                 obstacles, fast=False, on_map=False)
         self.sides = sides
         if trial is not None and self._disc_clear(self._leg(robot, trial.subtarget)):
             return False
@@ -581,7 +629,9 @@ class Planner:
         return dataclasses.replace(a, letter=committed.letter)
 
     def plan_detour(self, robot: Vec, threat: Assessment, obstacles: list[Obstacle],
-                    fast: bool) -> Detour | None:
+                    fast: bool, on_map: bool = True) -> Detour | None:
+        """Morphin round ``threat`` (Eq. 17) on the standing obstacles' cell boxes and the
+        movers; ``on_map`` (beyond the paper): also never through what the map holds."""
         p = self.p
         statics = self._statics(obstacles)
         lows, highs = self._boxes(statics)
@@ -621,6 +671,8 @@ class Planner:
                 switch_penalty=p.switch_penalty,
                 end_cost=lambda end: self._way_on_cost(robot, end, to_goal),
                 to_goal=to_goal,
+                crosses=(self._crosses_map if on_map and self.costmap is not None and p.use_map
+                         else None),
             )
             best = choice.best
             if best is not None:
@@ -662,14 +714,14 @@ class Planner:
         # The map may clear the way to the target (the path's look-ahead point, or the
         # detour's sub-target); whether a detour may end is still the boxes' call.
         clear = self._map_clear(robot, target, to_goal=self.detour is None)
-        threats = self._threats(notes, clear, stamp)
+        threats = self._threats(notes, clear, stamp, robot, target, self.detour is None)
         if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
                                                              in_window, stamp):
             # The path now goes round what the map holds: judge the way along it again.
             path_target = target = self.path_target(robot, self._statics(in_window))
             notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
             clear = self._map_clear(robot, target, to_goal=True)
-            threats = self._threats(notes, clear, stamp)
+            threats = self._threats(notes, clear, stamp, robot, target, True)
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
@@ -1079,8 +1131,10 @@ class Planner:
             goal = (float(self.goal[0]), float(self.goal[1]))
             self.costmap = Costmap(
                 start, goal, resolution=p.map_resolution, decay=p.map_decay,
-                inflation=p.robot_radius + p.safety_margin,
-                confirm=p.map_confirm, padding=p.map_padding, max_size=p.map_max_size)
+                inflation=p.robot_radius + p.safety_margin, confirm=p.map_confirm,
+                wall_decay=p.map_wall_decay, wall_confirm=p.map_wall_confirm,
+                padding=p.map_padding,
+                max_size=p.map_max_size)
         if scan is None:
             return
         movers = [(o.position[0], o.position[1], o.radius) for o in obstacles

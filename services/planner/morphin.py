@@ -133,6 +133,7 @@ def choose_detour(
     switch_penalty: float = 0.0,
     end_cost: Callable[[Vec], float] | None = None,
     to_goal: Callable[[Vec], float] | None = None,
+    crosses: Callable[[Vec], bool] | None = None,
 ) -> Choice:
     """Score the fan of straight candidates around the centreline robot -> centre_point.
 
@@ -143,7 +144,9 @@ def choose_detour(
     not swing the robot from one side of an obstacle to the other. ``end_cost`` adds a
     cost for where a candidate ends (the caller's judgement of the way on from there).
     ``to_goal`` measures Delta L (m, divided by the cell here); the paper's straight-line
-    distance to ``goal`` when not given.
+    distance to ``goal`` when not given. ``crosses`` (beyond the paper): whether a
+    candidate's points, the robot's position first, run through something the caller
+    knows of besides ``boxes`` (the planner's map); such a candidate is blocked too.
     """
     offset = centre_point - robot
     length = float(np.hypot(*offset)) + extra_length
@@ -159,7 +162,8 @@ def choose_detour(
         shared = len(cells_on_segment(robot, end, cell) & global_cells)
         w = shared_term(shared)
         delta_l = (to_goal(end) if to_goal is not None else float(np.hypot(*(goal - end)))) / cell
-        blocked = _blocked(points, times, boxes, movers, robot_radius, margin)
+        blocked = (_blocked(points, times, boxes, movers, robot_radius, margin)
+                   or (crosses is not None and crosses(points)))
         cost = math.inf if blocked else morphin_cost(g, delta_l, w, kappa)
         if side and g * side < 0:
             cost += switch_penalty

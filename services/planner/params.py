@@ -207,6 +207,18 @@ class Params(MissionParams, StopZoneParams):
         60.0, gt=0, description="a cell not seen for this long is unknown again, s: longer "
         "than the tracks' 30 s memory, so the map outlives what the local layer forgets"
     )
+    map_wall_decay: float = Field(
+        600.0, gt=0, description="a wall of the map's memory (its returns came for "
+        "map_wall_confirm, no beam through it since) stays an obstacle this long after it "
+        "was last seen, s, and recovery's clearing keeps it: the walls of a maze or a long "
+        "corridor outlive map_decay, so the path does not go back through walls left "
+        "behind (at least map_decay)"
+    )
+    map_wall_confirm: float = Field(
+        5.0, ge=0, description="returns must come for this long before a wall is kept past "
+        "map_decay and through recovery's clearing, s: a slow walker beyond perception's "
+        "window leaves marks confirmed after map_confirm, not kept"
+    )
     map_confirm: float = Field(
         1.0, ge=0, description="a return must stay in its cell this long before the map "
         "counts it as an obstacle, s: a mover beyond perception's window (untyped) moves on "

@@ -85,3 +85,62 @@ def test_a_straight_wall_seen_side_on_from_close_by_is_confirmed_along_its_face(
     face = np.array([[0.35, y] for y in np.arange(-1.25, 1.3, 0.1)])
     assert cm.lethal_at(face).all()
     assert cm.blocked_at(np.array([[0.05, 0.0]]))[0]  # and the robot is in its inflation
+
+
+def walled(wall_confirm: float = 3.0) -> Costmap:
+    return Costmap((0.0, 0.0), (6.0, 0.0), resolution=0.1, decay=5.0, inflation=0.35,
+                   confirm=1.0, wall_decay=50.0, wall_confirm=wall_confirm, padding=2.0,
+                   max_size=100.0)
+
+
+def see(cm: Costmap, boxes: list[tuple[float, float, float, float]], start: float,
+        end: float) -> None:
+    """Scans from the origin facing +x every 0.5 s from ``start`` to ``end``."""
+    for k in range(round((end - start) / 0.5) + 1):
+        cm.update(scan_of((0.0, 0.0, 0.0), boxes=boxes), start + 0.5 * k)
+
+
+def test_a_wall_seen_long_enough_outlives_the_decay_until_its_own_decay_time() -> None:
+    cm = walled()
+    box = [(2.0, -0.5, 2.5, 0.5)]
+    see(cm, box, 0.0, 3.0)  # returns for 3 s: a wall kept past the decay
+    cm.update(scan_of((0.0, 0.0, math.pi)), 9.0)  # turned away, past the decay
+    assert value_at(cm, 2.05, 0.0) == OCCUPIED
+    assert value_at(cm, 1.0, 0.0) == UNKNOWN  # free space decays as before
+    cm.update(scan_of((0.0, 0.0, math.pi)), 54.0)  # past the wall's decay
+    assert not cm.lethal().any()
+
+
+def test_a_wall_seen_briefly_decays_like_the_rest() -> None:
+    cm = walled()
+    see(cm, [(2.0, -0.5, 2.5, 0.5)], 0.0, 2.0)  # a wall (1 s), but seen for 2 s only
+    assert cm.lethal().any()
+    cm.update(scan_of((0.0, 0.0, math.pi)), 8.0)
+    assert not cm.lethal().any()
+
+
+def test_recovery_s_clearing_keeps_the_walls_seen_long_and_a_beam_clears_them() -> None:
+    cm = walled()
+    box, post = [(2.0, -0.5, 2.5, 0.5)], [(4.0, 2.0, 4.2, 2.2)]
+    see(cm, box, 0.0, 1.5)
+    see(cm, box + post, 2.0, 3.5)  # the post: a wall, seen for 1.5 s only
+    cm.forget_older_than(4.0)
+    assert value_at(cm, 2.05, 0.0) == OCCUPIED  # the long-seen wall is kept
+    assert not cm.has_returns_in(np.array([3.9, 1.9]), np.array([4.3, 2.3]))  # forgotten
+    cm.update(scan_of((0.0, 0.0, 0.0)), 4.5)  # the box is gone: the beams pass through
+    assert value_at(cm, 2.05, 0.0) == FREE
+
+
+def test_returns_not_yet_confirmed_are_found_near_a_segment() -> None:
+    cm = fresh(confirm=1.0)
+    cm.update(scan_of((0.0, 0.0, 0.0), boxes=[(3.0, 0.6, 3.2, 1.0)]), 0.0)
+    assert not cm.lethal().any()  # one scan: not confirmed
+    lo, hi = np.array([2.5, 0.0]), np.array([3.5, 1.5])
+    assert cm.has_returns_in(lo, hi)
+    assert not cm.has_returns_in(np.array([0.0, -1.0]), np.array([1.0, 0.0]))
+    a, b = np.array([0.0, 0.0]), np.array([5.0, 0.0])  # passes 0.6 m below the face
+    assert not cm.returns_near_segment(a, b, 0.35)
+    assert cm.returns_near_segment(a, b, 0.7)
+    assert cm.returns_near_segment(a, np.array([3.1, 0.8]), 0.35)  # into it
+    assert not cm.returns_near_segment(a, np.array([3.1, 0.8]), 0.35,
+                                       np.array([0.0, -1.0]), np.array([1.0, 0.0]))

@@ -280,25 +280,29 @@ def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
 def test_the_compiled_lethal_cells_are_lethals(seed: int) -> None:
     """The lethal grid ``_refresh`` makes in one compiled pass (``_loops.lethal_cells``,
     what ``lethal_grid`` and the inflation read) against ``lethal()``, the numpy test:
-    cells seen and hit at random times, on the decay and confirmation edges exactly,
-    never seen (-inf), nan; and the cache kept only while the set stays the same."""
+    cells seen and hit at random times, walls among them, on the decay, wall decay and
+    confirmation edges exactly, never seen (-inf), nan; and the cache kept only while
+    the set stays the same."""
     rng = np.random.default_rng(seed)
     cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=2.0, inflation=0.3,
-                 confirm=0.5, padding=1.0, max_size=30.0)
+                 confirm=0.5, wall_decay=5.0, wall_confirm=1.0, padding=1.0,
+                 max_size=30.0)
     kept = renewed = 0
-    old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy())
+    old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy(), cm.walls.copy())
     for k in range(30):
         cm.now = 10.0 + 0.1 * k
         if rng.random() < 0.7:  # else the grids stay and only the time moves on
             cm.occupied = rng.random(cm.shape) < 0.3
-            cm.seen = rng.choice([cm.now - 2.0, cm.now - 1.0, cm.now - 3.0, -math.inf,
-                                  math.nan, cm.now], size=cm.shape)
+            cm.walls = rng.random(cm.shape) < 0.3
+            cm.seen = rng.choice([cm.now - 2.0, cm.now - 1.0, cm.now - 3.0, cm.now - 5.0,
+                                  cm.now - 6.0, -math.inf, math.nan, cm.now], size=cm.shape)
             cm.hit_since = rng.choice([cm.now - 0.5, cm.now - 0.4, cm.now, math.inf,
-                                       math.nan, cm.now - 9.0], size=cm.shape)
+                                       math.nan, cm.now - 9.0, cm.now - 4.0, cm.now - 7.0],
+                                      size=cm.shape)
             if rng.random() < 0.3 and k:  # the same cells again, new arrays
-                cm.occupied, cm.seen, cm.hit_since = old
+                cm.occupied, cm.seen, cm.hit_since, cm.walls = old
             cm.version += 1
-        old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy())
+        old = (cm.occupied.copy(), cm.seen.copy(), cm.hit_since.copy(), cm.walls.copy())
         before = cm._inflated
         got = cm.lethal_grid()
         with np.errstate(invalid="ignore"):

@@ -97,3 +97,23 @@ def test_a_mover_blocks_the_candidates_it_would_meet():
         robot_at = np.array(best.end) * (t * 0.2 / length)
         mover_at = np.array([4.0 - 0.5 * t, 0.0])
         assert np.hypot(*(robot_at - mover_at)) >= 0.5 - 0.02
+
+
+def test_a_candidate_the_caller_finds_crossing_something_is_blocked():
+    """``crosses`` (the planner's map) blocks what the boxes do not hold: with everything
+    to the left of the centreline crossing, the best detour goes right, though the box
+    sits a little right of the line and the left would be the smaller turn."""
+    robot, goal = np.array([0.0, 0.0]), np.array([10.0, 0.0])
+    box = (np.array([[2.75, -0.35]]), np.array([[3.25, 0.15]]))
+    common = dict(speed=0.1, cell=0.5, robot_radius=0.2, margin=0.1, kappa=KAPPA,
+                  fan_step=math.radians(5), fan_max=math.radians(85), extra_length=0.8)
+    free = choose_detour(robot, np.array([3.0, 0.0]), goal, set(), box, [], **common)
+    assert free.best is not None and free.best.g > 0  # left, without the map
+
+    def left_wall(points: np.ndarray) -> bool:  # a wall along y = 0.6
+        return bool((points[:, 1] > 0.6).any())
+
+    walled = choose_detour(robot, np.array([3.0, 0.0]), goal, set(), box, [],
+                           crosses=left_wall, **common)
+    assert walled.best is not None and walled.best.g < 0
+    assert all(math.isinf(c.cost) for c in walled.candidates if c.end[1] > 0.6)

@@ -281,3 +281,72 @@ def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the
                 if a[0] < 5.15 <= b[0]]
     assert len(crossing) == 1 and 3.9 < crossing[0][1][1] < 4.72  # through the gap
     assert x >= 5.8  # and on past the wall
+
+
+def test_a_morphin_detour_never_runs_through_a_wall_the_map_holds() -> None:
+    """A box a little right of the line, so that the paper's fan prefers the left, and a
+    wall on the left that only the map holds (no track of it): the sub-target is on the
+    right, and the straight way to it clear of the wall."""
+    wall = [(2.5, 3.55, 5.5, 3.75)]
+    p = planner()
+    blocker = box(1, 4.0, 2.85)
+    d = None
+    for k in range(26):
+        d = p.step(POSE, [blocker], k * 0.1, scan_of(POSE, boxes=wall))
+    assert d is not None and (d.scenario, d.action) == ("b", "morphin")
+    assert d.target[1] < 3.0
+    without_map = planner(use_map=False)
+    d = decide(without_map, [blocker])
+    assert d.target[1] > 3.75  # the same choice through the wall, without the map
+
+
+def test_a_young_standing_obstacle_whose_returns_keep_off_the_way_is_no_b() -> None:
+    """A track's cell box S_k over the robot's way while its returns, not yet confirmed
+    in the map, lie 0.6 m off it (the box of a wall's corner seen round a bend covers
+    the inside of the bend): no (b) detour. The same box with its returns on the way is
+    gone round, as in the paper."""
+    box_over_the_way = (6, 9, 5, 7)  # 0.5 m cells: x 3.0-5.0, y 2.5-3.75
+    track = Obstacle(1, "static", (4.0, 3.4), (0.0, 0.0), 0.6, box_over_the_way)
+    off = [(3.0, 3.6, 4.8, 3.75)]  # the returns: a wall face 0.6 m left of the way
+    d = planner().step(POSE, [track], 0.0, scan_of(POSE, boxes=off))
+    assert (d.scenario, d.action) == ("a", "keep")
+    on = [(3.6, 2.9, 3.8, 3.75)]  # now the face crosses the way
+    d = planner().step(POSE, [track], 0.0, scan_of(POSE, boxes=on))
+    assert (d.scenario, d.action) == ("b", "morphin")
+    d = planner(use_map=False).step(POSE, [track], 0.0, scan_of(POSE, boxes=off))
+    assert (d.scenario, d.action) == ("b", "morphin")  # without the map: the box decides
+
+
+def test_round_a_bend_the_robot_steers_for_the_corner_while_its_returns_are_young() -> None:
+    """The look-ahead point is round a bend of the global path and the chord to it runs
+    0.15 m past the bend's inner corner, seen in one scan only (not yet lethal): the
+    robot steers for the bend's vertex instead. With nothing seen there, for the point."""
+    robot, pose = np.array([2.5, 3.0]), (2.5, 3.0, 0.0)
+    bent = np.array([[2.0, 3.0], [3.0, 3.0], [3.0, 5.0], [8.0, 5.0]])
+    for corner, want in (([(2.85, 3.3, 2.95, 3.5)], (3.0, 3.0)), ([], (3.0, 3.5))):
+        p = planner()
+        p.update_map(pose, [], scan_of(pose, boxes=corner), 0.0)
+        p._set_path(bent, "test")
+        assert p.path_target(robot) == pytest.approx(want)
+
+
+def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
+    """Off the path, the robot rejoins it at the farthest point its boxes let it reach in
+    a straight line; a return the map holds on that straight way (not a track, so not in
+    the boxes) sends it back to the look-ahead rule instead."""
+    robot, pose = np.array([2.6, 2.6]), (2.6, 2.6, 0.0)
+    bent = np.array([[2.0, 3.0], [3.0, 3.0], [3.0, 5.0], [8.0, 5.0]])
+    far = [Obstacle(1, "static", (9.0, 0.0), (0.0, 0.0), 0.2, cells(9.0, 0.0))]
+    p = planner()
+    p.update_map(pose, [], scan_of(pose), 0.0)
+    p._set_path(bent, "test")
+    rejoin = p.path_target(robot, far)
+    assert rejoin == pytest.approx(p._rejoin_point(robot, far))  # the boxes' choice
+    middle = (robot + rejoin) / 2
+    mark = [(middle[0] - 0.05, middle[1] - 0.05, middle[0] + 0.05, middle[1] + 0.05)]
+    p = planner()
+    p.update_map(pose, [], scan_of(pose, boxes=mark), 0.0)
+    p._set_path(bent, "test")
+    target = p.path_target(robot, far)
+    assert target != pytest.approx(rejoin)
+    assert p._chord_clear(robot, target)
