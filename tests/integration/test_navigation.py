@@ -52,7 +52,7 @@ def ground_truth_clearance(path: Path, trajectory: list[list[float]]) -> float:
 def test_there_is_a_scenario_for_every_class():
     names = {p.stem for p in SCENARIOS}
     for needed in ("appear", "wall-gap", "dead-end", "corridor-follower", "corridor-head-on",
-                   "corridor-sealed-head-on",
+                   "corridor-sealed-head-on", "hairpin",
                    "posts", "mover-stops", "facing-away"):
         assert any(needed in name for name in names), needed
 
