@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
 
 from zenav.services.planner.morphin import (
+    Choice,
     Mover,
     cells_on_segment,
     choose_detour,
@@ -105,15 +107,19 @@ def test_a_candidate_the_caller_finds_crossing_something_is_blocked():
     sits a little right of the line and the left would be the smaller turn."""
     robot, goal = np.array([0.0, 0.0]), np.array([10.0, 0.0])
     box = (np.array([[2.75, -0.35]]), np.array([[3.25, 0.15]]))
-    common = dict(speed=0.1, cell=0.5, robot_radius=0.2, margin=0.1, kappa=KAPPA,
-                  fan_step=math.radians(5), fan_max=math.radians(85), extra_length=0.8)
-    free = choose_detour(robot, np.array([3.0, 0.0]), goal, set(), box, [], **common)
+
+    def fan(crosses: Callable[[np.ndarray], bool] | None = None) -> Choice:
+        return choose_detour(robot, np.array([3.0, 0.0]), goal, set(), box, [], speed=0.1,
+                             cell=0.5, robot_radius=0.2, margin=0.1, kappa=KAPPA,
+                             fan_step=math.radians(5), fan_max=math.radians(85),
+                             extra_length=0.8, crosses=crosses)
+
+    free = fan()
     assert free.best is not None and free.best.g > 0  # left, without the map
 
     def left_wall(points: np.ndarray) -> bool:  # a wall along y = 0.6
         return bool((points[:, 1] > 0.6).any())
 
-    walled = choose_detour(robot, np.array([3.0, 0.0]), goal, set(), box, [],
-                           crosses=left_wall, **common)
+    walled = fan(left_wall)
     assert walled.best is not None and walled.best.g < 0
     assert all(math.isinf(c.cost) for c in walled.candidates if c.end[1] > 0.6)
