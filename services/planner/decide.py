@@ -379,9 +379,9 @@ class Planner:
         all keep the inflation distance off the straight way the (b) test judged. The
         box of a wall's corner first seen round a bend (an L of returns) covers the free
         inside of the bend, and answering it with a detour turned the robot back at a
-        corridor's turn. False when the box holds no return: the box decides, as in the
-        paper."""
-        if self.costmap is None:
+        corridor's turn. False for an obstacle smaller than ``wall_radius`` and when the
+        box holds no return: the box decides, as in the paper."""
+        if self.costmap is None or a.obstacle.radius < self.p.wall_radius:
             return False
         lo, hi = cell_squares(a.obstacle.cells, self.p.cell)
         offset = target - robot

@@ -88,6 +88,12 @@ class Params(MissionParams, StopZoneParams):
     confirm_distance: float = Field(
         0.6, ge=0, description="... unless the path meets it closer than this, m"
     )
+    wall_radius: float = Field(
+        0.5, ge=0, description="a standing obstacle at least this big (its radius, m) is "
+        "no (b) while too young for the map if the map's returns in its cell box keep off "
+        "the way: the box of a wall's corner seen round a bend covers the bend's inside. "
+        "A smaller one (a post, a walker standing) is judged on its box, as in the paper"
+    )
 
     safety_horizon: float = Field(
         6.0, gt=0, description="the longest time the speed and safety stage rolls the "
