@@ -315,6 +315,9 @@ def test_a_young_standing_obstacle_whose_returns_keep_off_the_way_is_no_b() -> N
     assert (d.scenario, d.action) == ("b", "morphin")
     d = planner(use_map=False).step(POSE, [track], 0.0, scan_of(POSE, boxes=off))
     assert (d.scenario, d.action) == ("b", "morphin")  # without the map: the box decides
+    small = Obstacle(1, "static", (4.0, 3.4), (0.0, 0.0), 0.3, box_over_the_way)
+    d = planner().step(POSE, [small], 0.0, scan_of(POSE, boxes=off))
+    assert (d.scenario, d.action) == ("b", "morphin")  # under wall_radius: the box decides
 
 
 def test_round_a_bend_the_robot_steers_for_the_corner_while_its_returns_are_young() -> None:
