@@ -42,17 +42,30 @@ def records(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict[str, Any
         return dict(pool.map(lambda p: (p.stem, zenav_run(p, base / p.stem)), SCENARIOS))
 
 
-def ground_truth_clearance(path: Path, trajectory: list[list[float]]) -> float:
+def ground_truth_clearance(path: Path, record: dict[str, Any]) -> float:
+    """The least gap between the robot disc and every obstacle over the run: the fixed
+    ones from the scenario, the ORCA agents from the record's own rows (the spec's
+    ``agents``: by index in ``obstacles``, at the trajectory's ticks)."""
     scenario = load_scenario(path)
     world = World.from_scenario(scenario)
-    return min((clearance((row[1], row[2]), scenario.robot.radius, world.snapshot(row[0]))
-                for row in trajectory), default=math.inf)
+    trajectory = record["trajectory"]
+    gaps = [clearance((row[1], row[2]), scenario.robot.radius, world.snapshot(row[0]))
+            for row in trajectory]
+    for index, rows in record.get("agents", {}).items():
+        agent = scenario.obstacles[int(index)]
+        assert agent.radius is not None, f"agent {index} is a disc"
+        assert len(rows) == len(trajectory), f"agent {index}: one row per tick"
+        for robot, (t, x, y) in zip(trajectory, rows, strict=True):
+            assert t == pytest.approx(robot[0])
+            gaps.append(math.dist(robot[1:3], (x, y)) - scenario.robot.radius - agent.radius)
+    return min(gaps, default=math.inf)
 
 
 def test_there_is_a_scenario_for_every_class():
     names = {p.stem for p in SCENARIOS}
     for needed in ("appear", "wall-gap", "dead-end", "corridor-follower", "corridor-head-on",
-                   "corridor-sealed-head-on", "hairpin",
+                   "corridor-sealed-head-on", "hairpin", "slalom", "room-door-behind",
+                   "door-two-way",
                    "posts", "mover-stops", "facing-away"):
         assert any(needed in name for name in names), needed
 
@@ -64,7 +77,7 @@ def test_class_scenario_is_reached_without_contact(path, records):
     assert record["outcome"] == "reached", f"{path.stem}: {record['outcome']} at {record['time']}"
     last = record["trajectory"][-1]
     assert math.dist(last[1:3], scenario.robot.goal) <= scenario.robot.goal_tolerance + 1e-6
-    assert ground_truth_clearance(path, record["trajectory"]) > 0.0
+    assert ground_truth_clearance(path, record) > 0.0
     assert record["path"][-1] == pytest.approx(list(scenario.robot.goal))
 
 
