@@ -82,8 +82,11 @@ def on_router(source: str, target: Path, **changes: object) -> tuple[Deployed, s
     return Deployed(config, target.with_suffix(".run")), endpoint
 
 
-def test_a_recorded_run_replayed_into_perception_tracking_and_planner_gives_the_same_outputs(
-        tmp_path):
+def record_and_replay(tmp_path: Path) -> str | None:
+    """One attempt: a live run recorded, then replayed. Every check of the recording, of
+    perception's chains and of the outputs' equality is asserted; returns why the
+    stateful stages could not be compared (None when they were)."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
     # A live run at 4x real time, recorded; the simulator waits for the recorder.
     live, endpoint = on_router("stack.yaml", tmp_path / "live.yaml")
     live.up_args = ["--set", "simulator.realtime_factor=4",
@@ -183,8 +186,30 @@ def test_a_recorded_run_replayed_into_perception_tracking_and_planner_gives_the_
         same = [s for s in same if first is not None and s >= first]
         alike = [s for s in same if (s in recorded[topic]) == (s in again[topic])]
         same = same_prefix(same, alike)
-        assert len(same) >= 10, f"the {topic} differ from the start"
+        # Equal wherever both runs were fed the same, however few chains that is.
         assert [again[topic].get(s) for s in same] == [recorded[topic].get(s) for s in same]
+        if len(same) < 10:
+            return (f"the {topic} were fed the same for {len(same)} chains only: obstacles "
+                    f"live {sorted(recorded['obstacles'])[:12]}, replayed "
+                    f"{sorted(again['obstacles'])[:12]}; {topic} live "
+                    f"{sorted(recorded[topic])[:12]}, replayed {sorted(again[topic])[:12]}")
     print(f"replay: {len(comparable)} of {len(scans)} scans answered after the same recent "
           f"scans gave the same chain ({len(common)} answered in both runs); tracks and "
           f"commands identical over {len(same)} chains")
+    return None
+
+
+def test_a_recorded_run_replayed_into_perception_tracking_and_planner_gives_the_same_outputs(
+        tmp_path):
+    # A loaded host may drop a scan in the first second of either run (a stage still
+    # warming up); tracking and the planner then differ from there on, rightly, and too
+    # few chains are left to compare. That attempt proves nothing either way: the test
+    # tries again, up to three times. Outputs that differ on the same inputs fail at once.
+    reasons: list[str] = []
+    for attempt in range(3):
+        reason = record_and_replay(tmp_path / f"attempt-{attempt}")
+        if reason is None:
+            return
+        reasons.append(reason)
+    pytest.fail("no attempt could compare tracking and the planner over 10 chains:\n"
+                + "\n".join(reasons))
