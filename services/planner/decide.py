@@ -652,6 +652,16 @@ class Planner:
         else:  # to the potential collision point, and past the mover's footprint
             centre = robot + axis * max(threat.robot_distance, p.cell)
             extra = clearance + threat.obstacle.radius
+        # Beyond the paper: a detour never reaches farther from the robot than the goal.
+        # Past a walker standing by the goal, the paper's length (to S_k's far side and a
+        # clearance more) puts the sub-target beyond the goal, and the robot drives by
+        # the goal to reach it.
+        to_the_goal = float(np.hypot(*(self.goal - robot)))
+        ahead = float(np.hypot(*(centre - robot)))
+        if ahead + extra > to_the_goal:
+            ahead = min(ahead, max(to_the_goal, p.cell))
+            centre = robot + axis * ahead
+            extra = max(to_the_goal - ahead, 0.0)
         to_goal = self._to_goal(robot, lows, highs)
         # Keep to the side already taken round this obstacle (or the detour under way):
         # swinging from one side to the other between obstacles gets nowhere.

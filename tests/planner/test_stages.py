@@ -283,6 +283,18 @@ def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the
     assert x >= 5.8  # and on past the wall
 
 
+@pytest.mark.parametrize("goal_x", [4.2, 4.4, 4.5])
+def test_a_detour_never_leads_farther_than_the_goal(goal_x: float) -> None:
+    """A box just short of the goal: the paper's detour length (to its far side and a
+    clearance more, 2.55 m here) would put the sub-target past the goal."""
+    d = decide(planner(goal=(goal_x, 3.0)), [box(1, 4.0, 3.0)])
+    assert (d.scenario, d.action) == ("b", "morphin")
+    assert math.dist(d.target, POSE[:2]) == pytest.approx(goal_x - POSE[0])
+    assert abs(d.target[1] - 3.0) > 0.3  # still off the line, round the box
+    far = decide(planner(goal=(5.3, 3.0)), [box(1, 4.0, 3.0)])
+    assert math.dist(far.target, POSE[:2]) == pytest.approx(2.55, abs=0.01)  # as the paper
+
+
 def test_a_morphin_detour_never_runs_through_a_wall_the_map_holds() -> None:
     """A box a little right of the line, so that the paper's fan prefers the left, and a
     wall on the left that only the map holds (no track of it): the sub-target is on the
