@@ -56,6 +56,7 @@ class Simulation:
         self.crowd.start(self._robot_motion(0.0, self.state, (0.0, 0.0)))
         self.agent_rows: list[deque[tuple[float, float, float]]] = [
             deque(maxlen=keep) for _ in self.crowd.ids]
+        self._snapshot: tuple[int, WorldSnapshot] | None = None  # (tick, its obstacles)
         self._record(0.0)
 
     @property
@@ -66,7 +67,11 @@ class Simulation:
         return self.tick % self.ticks_per_scan == 0
 
     def snapshot(self) -> WorldSnapshot:
-        return self.snapshot_at(self.t, self.crowd.positions_at(self.t))
+        """The obstacles now. A tick asks three times (the run record's clearance, the
+        scan, the ground truth), with nothing moved in between: made once per tick."""
+        if self._snapshot is None or self._snapshot[0] != self.tick:
+            self._snapshot = (self.tick, self.snapshot_at(self.t, self.crowd.positions_at(self.t)))
+        return self._snapshot[1]
 
     def snapshot_at(self, t: float, agent_positions: np.ndarray) -> WorldSnapshot:
         """The obstacles at ``t`` (s), the agents at ``agent_positions`` (m) among them."""
@@ -109,7 +114,11 @@ class Simulation:
         agents = self.crowd.positions_at(t) if agent_positions is None else agent_positions
         for rows, (x, y) in zip(self.agent_rows, agents, strict=True):
             rows.append((t, float(x), float(y)))
-        gap = clearance((s.x, s.y), self.scenario.robot.radius, self.snapshot_at(t, agents))
+        # The obstacles of the tick just made (cached for its scan and ground truth), or
+        # at a contact, those at its time.
+        snap = (self.snapshot() if agent_positions is None and t == self.t
+                else self.snapshot_at(t, agents))
+        gap = clearance((s.x, s.y), self.scenario.robot.radius, snap)
         self.min_clearance = min(self.min_clearance, gap)
 
     def step(self, v: float, omega: float) -> None:
