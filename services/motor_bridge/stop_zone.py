@@ -10,6 +10,8 @@ tracking or planning cannot drive the robot into what the laser sees.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import numpy.typing as npt
 from pydantic import BaseModel, Field
@@ -67,10 +69,22 @@ def zone_blocked(
     if v <= 0.0:
         return False
     r = np.asarray(ranges, dtype=np.float64)
-    angles = angle_min + angle_increment * np.arange(r.shape[0])
+    cosines, sines = _beam_directions(angle_min, angle_increment, r.shape[0])
     hit = r < range_max
-    x = r * np.cos(angles)
-    y = r * np.sin(angles)
+    x = r * cosines
+    y = r * sines
     half_width = robot_radius + side_margin
     inside = hit & (x > 0.0) & (x <= robot_radius + ahead) & (np.abs(y) <= half_width)
     return bool(inside.any())
+
+
+@functools.lru_cache(maxsize=8)
+def _beam_directions(angle_min: float, angle_increment: float, count: int
+                     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The cosines and sines of the beams' angles (read-only): the same laser scan after
+    scan, and the zone is checked twice a scan (by the planner, then the bridge)."""
+    angles = angle_min + angle_increment * np.arange(count)
+    cosines, sines = np.cos(angles), np.sin(angles)
+    cosines.setflags(write=False)
+    sines.setflags(write=False)
+    return cosines, sines
