@@ -337,6 +337,26 @@ def line_any(double sx, double sy, double dx, double dy, double length, Py_ssize
     return False
 
 
+def max_along(double sx, double sy, double dx, double dy, Py_ssize_t count, double ox,
+              double oy, double resolution, const double[::1] grid, Py_ssize_t ny):
+    """The highest value of the flat grid (``ny`` cells a column) at the cells of the
+    ``count`` points ``(sx, sy) + t (dx, dy)``, ``t`` the points of
+    ``np.linspace(0, 1, count)`` (``count`` >= 2), each found as ``Costmap.cell_of``
+    finds it; the points beyond the grid skipped; 0 if none is in it or all are below.
+    (``global_path._cost_along``, leg by leg.)"""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, ix, iy
+    cdef double step = 1.0 / <double>(count - 1), t, worst = 0.0
+    for i in range(count):
+        t = spaced(i, count, 1.0, step)
+        ix = cell_index(sx + t * dx - ox, resolution)
+        iy = cell_index(sy + t * dy - oy, resolution)
+        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+            if grid[ix * ny + iy] > worst:
+                worst = grid[ix * ny + iy]
+    return worst
+
+
 def project_on(const double[:, ::1] points, const double[::1] lengths, double px,
                double py):
     """(s, d) of ``global_path.project``: the arc length of the point of the polyline

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from zenav.services.planner._loops import point_on, project_on
+from zenav.services.planner._loops import line_any, max_along, point_on, project_on
 from zenav.services.planner.costmap import Costmap
 from zenav.services.planner.field import grid_distances
 
@@ -73,26 +73,29 @@ def _crosses(grid: BoolGrid, a: tuple[int, int], b: tuple[int, int]) -> bool:
 
 def visible(free: BoolGrid, costmap: Costmap, a: Vec, b: Vec) -> bool:
     """Whether the straight segment a-b passes through free cells only (sampled every
-    quarter cell; a point beyond the grid is not free: there is no map of it)."""
+    quarter cell; a point beyond the grid is not free: there is no map of it). In
+    compiled code (``_loops.line_any`` over the points ``a + t (b - a)``, ``t`` the points
+    of ``np.linspace(0, 1, count)``), stopping at the first point that is not free."""
     length = float(np.hypot(*(b - a)))
     count = max(2, math.ceil(length / (costmap.resolution / 4)) + 1)
-    t = np.linspace(0.0, 1.0, count)[:, None]
-    points = a[None, :] + t * (b - a)[None, :]
-    cells = costmap.cell_of(points)
-    ok = costmap.inside(cells)
-    return bool(ok.all() and free[cells[:, 0], cells[:, 1]].all())
+    (ax, ay), (dx, dy) = a.tolist(), (b - a).tolist()
+    walls = np.ascontiguousarray(~free).reshape(-1).view(np.uint8)
+    return not line_any(ax, ay, dx, dy, 1.0, count, float(costmap.origin[0]),
+                        float(costmap.origin[1]), costmap.resolution, walls, free.shape[1],
+                        True)
 
 
 def _cost_along(cost: npt.NDArray[np.float64], costmap: Costmap, points: Vec) -> float:
-    """The highest comfort cost over a polyline's cells (sampled every quarter cell)."""
+    """The highest comfort cost over a polyline's cells (sampled every quarter cell, leg
+    by leg, in compiled code: ``_loops.max_along``; cells beyond the grid skipped)."""
+    flat = np.ascontiguousarray(cost).reshape(-1)
+    ox, oy = float(costmap.origin[0]), float(costmap.origin[1])
     worst = 0.0
     for a, b in itertools.pairwise(points):
         count = max(2, math.ceil(float(np.hypot(*(b - a))) / (costmap.resolution / 4)) + 1)
-        t = np.linspace(0.0, 1.0, count)[:, None]
-        cells = costmap.cell_of(a[None, :] + t * (b - a)[None, :])
-        ok = costmap.inside(cells)
-        if ok.any():
-            worst = max(worst, float(cost[cells[ok, 0], cells[ok, 1]].max()))
+        (ax, ay), (dx, dy) = a.tolist(), (b - a).tolist()
+        worst = max(worst, max_along(ax, ay, dx, dy, count, ox, oy, costmap.resolution, flat,
+                                     cost.shape[1]))
     return worst
 
 
@@ -104,14 +107,17 @@ def shortcut(free: BoolGrid, costmap: Costmap, points: Vec,
     replaces did: it cuts corners of the way, not into the room kept round obstacles."""
     if len(points) <= 2:
         return points
+    # Each leg's cost once: the cost along the vertices i..j is the highest of their
+    # legs' (``_cost_along`` over them, leg by leg, from 0), asked for again and again.
+    legs = ([] if cost is None else
+            [_cost_along(cost, costmap, points[k:k + 2]) for k in range(len(points) - 1)])
 
     def ok(i: int, j: int) -> bool:
         if not visible(free, costmap, points[i], points[j]):
             return False
         if cost is None:
             return True
-        return (_cost_along(cost, costmap, points[[i, j]])
-                <= _cost_along(cost, costmap, points[i:j + 1]) + 1e-9)
+        return _cost_along(cost, costmap, points[[i, j]]) <= max(0.0, *legs[i:j]) + 1e-9
 
     kept = [0]
     i = 0

@@ -1,0 +1,120 @@
+"""The global path's line tests in compiled code (``visible`` over ``_loops.line_any``,
+``_cost_along`` over ``_loops.max_along``) give, to the bit, what the numpy sampling they
+replaced gives: on random grids, for segments inside the grid, leaving it, starting
+outside it, and of zero length; and the shortcut, which asks them hundreds of times a
+plan, keeps the same vertices."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from zenav.services.planner.costmap import Costmap
+from zenav.services.planner.global_path import _cost_along, shortcut, visible
+
+Vec = np.ndarray
+
+
+def numpy_points(costmap: Costmap, a: Vec, b: Vec) -> np.ndarray:
+    """The cells of the quarter-cell samples of a-b (the numpy code both replaced)."""
+    count = max(2, math.ceil(float(np.hypot(*(b - a))) / (costmap.resolution / 4)) + 1)
+    t = np.linspace(0.0, 1.0, count)[:, None]
+    return costmap.cell_of(a[None, :] + t * (b - a)[None, :])
+
+
+def numpy_visible(free: np.ndarray, costmap: Costmap, a: Vec, b: Vec) -> bool:
+    cells = numpy_points(costmap, a, b)
+    ok = costmap.inside(cells)
+    return bool(ok.all() and free[cells[:, 0], cells[:, 1]].all())
+
+
+def numpy_cost_along(cost: np.ndarray, costmap: Costmap, points: Vec) -> float:
+    worst = 0.0
+    for a, b in itertools.pairwise(points):
+        cells = numpy_points(costmap, a, b)
+        ok = costmap.inside(cells)
+        if ok.any():
+            worst = max(worst, float(cost[cells[ok, 0], cells[ok, 1]].max()))
+    return worst
+
+
+def random_map(rng: np.random.Generator) -> tuple[Costmap, np.ndarray, np.ndarray]:
+    costmap = Costmap((0.0, 0.0), (float(rng.uniform(3, 8)), float(rng.uniform(-4, 4))),
+                      resolution=float(rng.choice([0.05, 0.1, 0.25])), decay=60.0,
+                      inflation=0.3, padding=2.0, max_size=40.0)
+    nx, ny = costmap.shape
+    free = rng.random((nx, ny)) > rng.uniform(0.0, 0.2)
+    cost = np.where(rng.random((nx, ny)) < 0.3, rng.uniform(0.0, 2.0, (nx, ny)), 0.0)
+    return costmap, free, cost
+
+
+def segment_ends(costmap: Costmap, rng: np.random.Generator) -> tuple[Vec, Vec]:
+    """Two points mostly on the grid, some beyond it, some on cell edges exactly."""
+    nx, ny = costmap.shape
+    lo = costmap.origin - 1.0
+    hi = costmap.origin + np.array([nx, ny]) * costmap.resolution + 1.0
+    a, b = rng.uniform(lo, hi), rng.uniform(lo, hi)
+    if rng.random() < 0.2:  # on cell edges
+        a = costmap.origin + rng.integers(0, min(nx, ny), 2) * costmap.resolution
+    if rng.random() < 0.05:
+        b = a.copy()
+    return a, b
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_visible_and_the_cost_along_a_line_are_the_numpy_samplings(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    costmap, free, cost = random_map(rng)
+    seen = {True: 0, False: 0}
+    for _ in range(200):
+        a, b = segment_ends(costmap, rng)
+        expected = numpy_visible(free, costmap, a, b)
+        assert visible(free, costmap, a, b) == expected
+        seen[expected] += 1
+        points = np.vstack([a, b] + [segment_ends(costmap, rng)[0]
+                                     for _ in range(int(rng.integers(0, 4)))])
+        assert _cost_along(cost, costmap, points) == numpy_cost_along(cost, costmap, points)
+    assert seen[True] and seen[False]  # both answers were exercised
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_shortcut_keeps_the_vertices_of_the_numpy_tests(seed: int) -> None:
+    """A grid path of cell centres round random walls, shortcut with the compiled tests
+    and with a copy of the loop that asks the numpy ones."""
+    rng = np.random.default_rng(100 + seed)
+    costmap, free, cost = random_map(rng)
+    free[:] = True
+    nx, ny = costmap.shape
+    for _ in range(6):  # a few walls
+        i, j = int(rng.integers(0, nx)), int(rng.integers(0, ny))
+        free[i:i + int(rng.integers(1, 8)), j:j + 2] = False
+    walk = [(int(rng.integers(0, nx)), int(rng.integers(0, ny)))]
+    while len(walk) < 60:
+        i, j = walk[-1]
+        step = (i + int(rng.integers(-1, 2)), j + int(rng.integers(-1, 2)))
+        if 0 <= step[0] < nx and 0 <= step[1] < ny and free[step]:
+            walk.append(step)
+    points = costmap.centre_of(np.array(walk))
+
+    def numpy_shortcut() -> np.ndarray:
+        def ok(i: int, j: int) -> bool:
+            return (numpy_visible(free, costmap, points[i], points[j])
+                    and numpy_cost_along(cost, costmap, points[[i, j]])
+                    <= numpy_cost_along(cost, costmap, points[i:j + 1]) + 1e-9)
+        kept, i, last = [0], 0, len(points) - 1
+        while i < last:
+            j = last
+            while j > i + 1 and not ok(i, j):
+                j = i + 1 + (j - i - 1) // 2 if j - i > 8 else j - 1
+            while j < last and ok(i, j + 1):
+                j += 1
+            kept.append(j)
+            i = j
+        return points[kept]
+
+    expected = numpy_shortcut()
+    assert len(expected) < len(points)  # it did cut something
+    np.testing.assert_array_equal(shortcut(free, costmap, points, cost), expected)
