@@ -139,7 +139,7 @@ def first_difference(stack: Mapping[str, Any], inprocess: Mapping[str, Any]) -> 
     return None
 
 
-@dataclass
+@dataclass(repr=False)
 class EngineRun:
     """What the engine gathered: the simulator's result and the planner's events."""
 
@@ -149,6 +149,13 @@ class EngineRun:
     path: GlobalPath | None = None  # the newest global path the planner published
     occupancy: OccupancyMap | None = None  # and the newest map
     paths: list[GlobalPath] = field(default_factory=list)  # each distinct path, oldest first
+
+    def __repr__(self) -> str:
+        # Short: asyncio's runner formats the main task (and so this, its result) into
+        # an error message it then drops, twice a run; the full repr of the record's
+        # arrays cost 40 ms each time.
+        return (f"EngineRun({self.result.outcome} at t={self.result.time:.2f} s, "
+                f"{len(self.events)} events, {len(self.paths)} paths)")
 
 
 def add_path(paths: list[GlobalPath], path: GlobalPath) -> None:
