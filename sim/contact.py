@@ -80,41 +80,43 @@ def first_contact(
     ids: list[NDArray[np.int64]] = []
 
     # Discs: the robot centre against a circle of radius r_obstacle + radius.
-    start, span, q, v = _relative_motion(
-        a,
-        u,
-        (t0, t1),
-        centers=world.disc_centers,
-        velocities=world.disc_velocities,
-        appear=world.disc_appear,
-        vanish=world.disc_vanish,
-    )
-    reach = world.disc_radii + radius
-    near = _within_reach(q, v, span, reach)
-    if near.any():
-        s = np.full(len(q), np.inf)
-        s[near] = circle_entry_time((q[near, 0], q[near, 1]), (v[near, 0], v[near, 1]),
-                                    reach[near])
-        times.append(_contact_times(start, span, s, world.disc_vanish))
-        ids.append(world.disc_ids)
+    if len(world.disc_ids):
+        start, span, q, v = _relative_motion(
+            a,
+            u,
+            (t0, t1),
+            centers=world.disc_centers,
+            velocities=world.disc_velocities,
+            appear=world.disc_appear,
+            vanish=world.disc_vanish,
+        )
+        reach = world.disc_radii + radius
+        near = _within_reach(q, v, span, reach)
+        if near.any():
+            s = np.full(len(q), np.inf)
+            s[near] = circle_entry_time((q[near, 0], q[near, 1]), (v[near, 0], v[near, 1]),
+                                        reach[near])
+            times.append(_contact_times(start, span, s, world.disc_vanish))
+            ids.append(world.disc_ids)
 
     # Boxes: the robot centre against the box inflated by the radius (rounded rectangle).
-    start, span, q, v = _relative_motion(
-        a,
-        u,
-        (t0, t1),
-        centers=world.box_centers,
-        velocities=world.box_velocities,
-        appear=world.box_appear,
-        vanish=world.box_vanish,
-    )
-    half = world.box_half_sizes
-    near = _within_reach(q, v, span, np.hypot(half[:, 0], half[:, 1]) + radius)
-    if near.any():
-        s = np.full(len(q), np.inf)
-        s[near] = _rounded_box_entry_time(q[near], v[near], half[near], radius)
-        times.append(_contact_times(start, span, s, world.box_vanish))
-        ids.append(world.box_ids)
+    if len(world.box_ids):
+        start, span, q, v = _relative_motion(
+            a,
+            u,
+            (t0, t1),
+            centers=world.box_centers,
+            velocities=world.box_velocities,
+            appear=world.box_appear,
+            vanish=world.box_vanish,
+        )
+        half = world.box_half_sizes
+        near = _within_reach(q, v, span, np.hypot(half[:, 0], half[:, 1]) + radius)
+        if near.any():
+            s = np.full(len(q), np.inf)
+            s[near] = _rounded_box_entry_time(q[near], v[near], half[near], radius)
+            times.append(_contact_times(start, span, s, world.box_vanish))
+            ids.append(world.box_ids)
 
     if not times:
         return None
