@@ -82,14 +82,8 @@ def first_contact(
     # Discs: the robot centre against a circle of radius r_obstacle + radius.
     if len(world.disc_ids):
         start, span, q, v = _relative_motion(
-            a,
-            u,
-            (t0, t1),
-            centers=world.disc_centers,
-            velocities=world.disc_velocities,
-            appear=world.disc_appear,
-            vanish=world.disc_vanish,
-        )
+            a, u, (t0, t1), centers=world.disc_centers, velocities=world.disc_velocities,
+            appear=world.disc_appear, vanish=world.disc_vanish)
         reach = world.disc_radii + radius
         near = _within_reach(q, v, span, reach)
         if near.any():
@@ -102,14 +96,8 @@ def first_contact(
     # Boxes: the robot centre against the box inflated by the radius (rounded rectangle).
     if len(world.box_ids):
         start, span, q, v = _relative_motion(
-            a,
-            u,
-            (t0, t1),
-            centers=world.box_centers,
-            velocities=world.box_velocities,
-            appear=world.box_appear,
-            vanish=world.box_vanish,
-        )
+            a, u, (t0, t1), centers=world.box_centers, velocities=world.box_velocities,
+            appear=world.box_appear, vanish=world.box_vanish)
         half = world.box_half_sizes
         near = _within_reach(q, v, span, np.hypot(half[:, 0], half[:, 1]) + radius)
         if near.any():
