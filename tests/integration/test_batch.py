@@ -12,6 +12,7 @@ from pathlib import Path
 import psutil
 import pytest
 
+from tests.integration.test_interrupt import sigint_as_usual
 from zenav.batch import Job, run_batch, sample
 from zenav.sim import SCENARIO_DIR
 
@@ -38,7 +39,8 @@ def test_ctrl_c_stops_the_workers_within_a_second(tmp_path: Path) -> None:
     command = [sys.executable, "-m", "zenav", "bench", "nav", "--planners", "paper",
                "--worlds", "6", "--families", "static", "--jobs", "2", "--verify", "0",
                "--no-progress", "--out", str(tmp_path)]
-    proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    with sigint_as_usual():
+        proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     parent = psutil.Process(proc.pid)
     deadline = time.monotonic() + 120
     while len(parent.children(recursive=True)) < 3:  # the forkserver and two workers
