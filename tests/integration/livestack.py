@@ -1,6 +1,6 @@
 """Helpers for the tests of long-running stacks: deployments under supervisord
-(``zenav up``/``zenav down``), a ``zenav monitor --jsonl`` process read live, and a pair of
-network namespaces joined by a veth pair."""
+(``zenav up``/``zenav down``), a ``zenav monitor --jsonl`` process read live, a pair of
+network namespaces joined by a veth pair, and children started to be sent Ctrl-C."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import json
 import os
 import random
 import shutil
+import signal
 import subprocess
 import sys
 import threading
@@ -34,6 +35,21 @@ LONG_SCENARIO = DATA / "long.yaml"
 """A longer run for the tests that stop services on the way."""
 
 Event = dict[str, Any]
+
+
+@contextlib.contextmanager
+def sigint_as_usual() -> Iterator[None]:
+    """Children started inside get Ctrl-C as at a terminal. A test run launched as a
+    background job of a shell script inherits SIGINT ignored, its children too, and
+    Python then keeps it ignored, so the Ctrl-C under test would do nothing. A signal
+    this process handles is back to its default in a child (exec), so it handles
+    SIGINT meanwhile."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 def zenav(*args: str) -> list[str]:

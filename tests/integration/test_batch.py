@@ -12,7 +12,7 @@ from pathlib import Path
 import psutil
 import pytest
 
-from tests.integration.test_interrupt import sigint_as_usual
+from tests.integration.livestack import sigint_as_usual
 from zenav.batch import Job, run_batch, sample
 from zenav.sim import SCENARIO_DIR
 

@@ -9,29 +9,14 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
+from tests.integration.livestack import sigint_as_usual
+
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = REPO / "sim" / "scenarios" / "a-no-obstacle.yaml"
-
-
-@contextmanager
-def sigint_as_usual() -> Iterator[None]:
-    """Children started inside get Ctrl-C as at a terminal. A test run launched as a
-    background job of a shell script inherits SIGINT ignored, its children too, and
-    Python then keeps it ignored, so the Ctrl-C under test would do nothing. A signal
-    this process handles is back to its default in a child (exec), so it handles
-    SIGINT meanwhile."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        yield
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
 
 
 def interrupt(argv: list[str], after: float, group: bool, cwd: Path) -> tuple[int, float, str]:
