@@ -177,7 +177,10 @@ class TrackingParams(BaseModel):
         gt=0.0,
         description="(smoothed) an innovation beyond this many standard deviations is taken as "
         "a jump of the measured point (what is visible changed), not as motion: the "
-        "position is reset to the measurement and the velocity kept.",
+        "position is reset to the measurement and the velocity kept. A jump that no change "
+        "of view explains (or one beyond the obstacle's diameter) may be another obstacle "
+        "taken for this one: the velocity is then kept only as a guess, with a new track's "
+        "uncertainty (init_speed_std), and learnt again from the next scans.",
     )
     init_speed_std: float = Field(
         1.0, gt=0.0, description="m/s (smoothed): prior standard deviation of a new track's speed."

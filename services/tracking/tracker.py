@@ -30,7 +30,9 @@ that the visible part of an obstacle changes with the viewpoint: slowly for a wh
 obstacle (the filter sees it as a few cm/s, below ``static_speed``), suddenly when it comes
 out of hiding or leaves the window. Partly hidden clusters get a larger measurement noise,
 and a jump of the measured point (beyond ``jump_sigmas``, or when a hidden obstacle comes
-into full view) resets the position instead of turning into velocity.
+into full view) resets the position instead of turning into velocity; when no change of
+view explains the jump, the velocity is kept only with a new track's uncertainty (the track
+may have taken another obstacle for its own).
 
 Everything is deterministic: no randomness, ties broken by order.
 """
@@ -689,11 +691,19 @@ class Tracker:
         iy = m.point[1] - t.y
         s = t.p00 + r2
         came_into_view = t.partial and not m.partial
-        if came_into_view or m.n_parts != t.n_parts or ix * ix + iy * iy > p.jump_sigmas**2 * s:
+        innovation2 = ix * ix + iy * iy
+        jumped = innovation2 > p.jump_sigmas**2 * s
+        if came_into_view or m.n_parts != t.n_parts or jumped:
             # What is visible changed (or the point jumped): the old point is not comparable,
             # so restart the position from the measurement and keep the velocity.
             t.x, t.y = m.point
             t.p00, t.p01 = r2, 0.0
+            view_changed = came_into_view or m.n_parts != t.n_parts
+            if jumped and (not view_changed or innovation2 > (2.0 * m.radius) ** 2):
+                # A jump that no change of view explains: perhaps another obstacle taken
+                # for this one (two walkers crossing). Its velocity is then as unknown as
+                # a new track's; kept as the mean, it is learnt again from the next scans.
+                t.p11 = max(t.p11, p.init_speed_std**2)
             return
         k0 = t.p00 / s
         k1 = t.p01 / s
@@ -714,7 +724,7 @@ class Tracker:
         in its first ``cue_warmup`` s, while the filter is sure of a high speed). The
         filtered speed alone cannot tell a slow walker from the drift of a box's visible
         part as the robot drives past (at 0.5 m/s that drift exceeds 0.2 m/s); the cue
-        can. A fast mover just come into view is caught by the cue's 0.5 s baseline."""
+        can. A fast mover just come into view is caught by the cue's shortest (0.2 s) baseline."""
         p = self.params
         if t.age <= p.new_frames:
             return "new"

@@ -296,3 +296,24 @@ def test_empty_chains() -> None:
     c = scan_clusters(still(0.0), *STATICS)
     assert len(tracker.update(0.1, still(0.0), c)) == 2
     assert len(tracker.update(0.2, still(0.0), Clusters.empty())) == 0  # tentative: dropped
+
+
+def test_a_track_that_jumps_onto_another_walker_learns_its_velocity_again() -> None:
+    # A walker going up (+y) vanishes and, 0.45 m off its predicted place, a second one
+    # going down is seen: the track takes it (the same view of one disc, a jump). The
+    # first walker's velocity is no clue to the second's, so the track must learn it
+    # again from the next scans, not hold the old one while the position keeps jumping.
+    def world(t: float) -> tuple[list[Disc], list[Box]]:
+        if t < 2.0:
+            return [(2.5, -1.0 + 0.7 * t, 0.25)], []
+        return [(2.5 + 0.45, 0.4 - 0.9 * (t - 2.0), 0.25)], []
+
+    frames = drive(world, still, 2.35, TrackingParams(), noise=0.01)
+    before = nearest(frames[19][1], 2.5, -1.0 + 0.7 * 1.9)
+    assert before is not None and before.vy > 0.5
+    ids = {tr.id for t, tracks in frames if t >= 2.0 for tr in tracks}
+    assert ids == {before.id}, "the second walker was not taken for the first"
+    after = nearest(frames[-1][1], 2.95, 0.4 - 0.9 * frames[-1][0] + 1.8)
+    assert after is not None
+    # Two scans after the jump its velocity points down (the old one kept: still up).
+    assert after.vy < -0.3, (after.vx, after.vy)
