@@ -279,6 +279,29 @@ end within 3 s of it)."""
 
 
 @contextlib.contextmanager
+def sigint_held() -> Iterator[None]:
+    """In the main thread: a SIGINT during the block is held until the block ends, then
+    raised as KeyboardInterrupt. Matplotlib's renderer calls back into Python, and an
+    interrupt raised in there comes out as another error (``ValueError: Invalid bounding
+    box``), a traceback and status 1 instead of the quiet 130. Elsewhere nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+
+    def on_sigint(signum: int, frame: FrameType | None) -> None:
+        held.append(signum)
+
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if held:
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
 def _interrupt_sets(stop: threading.Event) -> Iterator[None]:
     """In the main thread: SIGINT sets ``stop`` and raises KeyboardInterrupt (once; a
     second one while the stack stops is ignored, so the stop is not cut short). Elsewhere
@@ -387,6 +410,7 @@ def run_scenario(
     if picture:
         from zenav.plot import plot_run  # matplotlib is slow to import; only here
 
-        plot_run(scenario, record, out_dir / "run.png", occupancy=heard.occupancy,
-                 paths=heard.paths)
+        with sigint_held():  # about half a second of drawing; Ctrl-C then stops it
+            plot_run(scenario, record, out_dir / "run.png", occupancy=heard.occupancy,
+                     paths=heard.paths)
     return record

@@ -3,6 +3,8 @@ pixels, its last global path, and the paths it planned before, read from the axe
 
 from __future__ import annotations
 
+import os
+import signal
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -14,6 +16,7 @@ from matplotlib.colors import to_rgb
 
 import zenav.plot
 from zenav.plot import EARLIER_PATH_COLOUR, MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR, plot_run
+from zenav.run import sigint_held
 from zenav.schemas.messages import GlobalPath, OccupancyMap
 from zenav.sim.scenario import load_scenario
 
@@ -122,3 +125,16 @@ def test_run_png_names_the_first_paths_and_counts_the_rest(tmp_path, monkeypatch
     labels = picture.labels
     assert [lb for lb in labels if lb.startswith("path")] == [
         *(f"path {k} (t={k - 1}.0 s, off the path)" for k in range(1, 7)), "paths 7-9"]
+
+
+def test_ctrl_c_while_the_picture_is_drawn_lets_it_finish_then_stops(tmp_path: Path) -> None:
+    # zenav run draws run.png under sigint_held: an interrupt raised inside matplotlib's
+    # renderer came out as "ValueError: Invalid bounding box" and status 1. Held, the
+    # picture is drawn whole and the KeyboardInterrupt (status 130) comes after it.
+    out = tmp_path / "run.png"
+    with pytest.raises(KeyboardInterrupt), sigint_held():
+        os.kill(os.getpid(), signal.SIGINT)
+        plot_run(load_scenario(SCENARIO), record(None), out)
+    assert out.stat().st_size > 0
+    assert matplotlib.image.imread(out).shape[2] in (3, 4)  # a whole PNG
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
