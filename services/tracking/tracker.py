@@ -690,15 +690,14 @@ class Tracker:
         ix = m.point[0] - t.x
         iy = m.point[1] - t.y
         s = t.p00 + r2
-        came_into_view = t.partial and not m.partial
+        view_changed = (t.partial and not m.partial) or m.n_parts != t.n_parts
         innovation2 = ix * ix + iy * iy
         jumped = innovation2 > p.jump_sigmas**2 * s
-        if came_into_view or m.n_parts != t.n_parts or jumped:
+        if view_changed or jumped:
             # What is visible changed (or the point jumped): the old point is not comparable,
             # so restart the position from the measurement and keep the velocity.
             t.x, t.y = m.point
             t.p00, t.p01 = r2, 0.0
-            view_changed = came_into_view or m.n_parts != t.n_parts
             if jumped and (not view_changed or innovation2 > (2.0 * m.radius) ** 2):
                 # A jump that no change of view explains: perhaps another obstacle taken
                 # for this one (two walkers crossing). Its velocity is then as unknown as
