@@ -192,8 +192,9 @@ class Planner:
         """Where to steer on the global path: ``lookahead`` m beyond the robot's
         projection on it; or, when ``statics`` are given and the robot is off the path,
         the farthest point of the path within the window that it can drive to in a
-        straight line clear of them (beyond the paper: it rejoins the path past the
-        obstacles it went round instead of cutting back into them)."""
+        straight line clear of them and of what the map holds (beyond the paper: it
+        rejoins the path past the obstacles it went round instead of cutting back into
+        them)."""
         assert self.path is not None and self.lengths is not None
         p = self.p
         lengths = self.lengths
@@ -214,9 +215,18 @@ class Planner:
         rejoin = self._rejoin_point(robot, statics)
         if rejoin is None or project(self.path, rejoin, lengths)[0] < s0 + p.lookahead:
             return default
-        if not self._chord_clear(robot, rejoin):
-            return default  # clear of the boxes, not of what the map holds
-        return rejoin
+        if self._chord_clear(robot, rejoin):
+            return rejoin
+        # Clear of the boxes, not of what the map holds: the farthest point short of it
+        # whose chord the map lets through, or the look-ahead point.
+        s_rejoin = project(self.path, rejoin, lengths)[0]
+        s = s_rejoin - p.map_resolution
+        while s > s0 + p.lookahead:
+            point = point_at(self.path, s, lengths)
+            if self._chord_clear(robot, point):
+                return point
+            s -= p.map_resolution
+        return default
 
     def _to_goal(self, robot: Vec, lows: Vec, highs: Vec) -> Callable[[Vec], float]:
         """Delta L's distance to the goal: around the standing obstacles (``field.py``),

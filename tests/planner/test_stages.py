@@ -15,6 +15,7 @@ from tests.planner.scans import scan_of
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.planner.decide import Decision, Planner
+from zenav.services.planner.global_path import point_at, project
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
 
@@ -348,7 +349,8 @@ def test_round_a_bend_the_robot_steers_for_the_corner_while_its_returns_are_youn
 def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
     """Off the path, the robot rejoins it at the farthest point its boxes let it reach in
     a straight line; a return the map holds on that straight way (not a track, so not in
-    the boxes) sends it back to the look-ahead rule instead."""
+    the boxes) moves the rejoin point back along the path to the farthest one whose
+    straight way the map lets through, still beyond the look-ahead point."""
     robot, pose = np.array([2.6, 2.6]), (2.6, 2.6, 0.0)
     bent = np.array([[2.0, 3.0], [3.0, 3.0], [3.0, 5.0], [8.0, 5.0]])
     far = [Obstacle(1, "static", (9.0, 0.0), (0.0, 0.0), 0.2, cells(9.0, 0.0))]
@@ -365,3 +367,10 @@ def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
     target = p.path_target(robot, far)
     assert target != pytest.approx(rejoin)
     assert p._chord_clear(robot, target)
+    assert p.lengths is not None
+    s_target, off = project(p.path, target, p.lengths)
+    assert off == pytest.approx(0.0, abs=1e-9)  # a point of the path
+    s_robot = project(p.path, robot, p.lengths)[0]
+    assert s_target > s_robot + p.p.lookahead  # beyond the look-ahead point
+    beyond = point_at(p.path, s_target + p.p.map_resolution, p.lengths)
+    assert not p._chord_clear(robot, beyond)  # the farthest such point
