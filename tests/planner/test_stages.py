@@ -367,7 +367,7 @@ def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
     target = p.path_target(robot, far)
     assert target != pytest.approx(rejoin)
     assert p._chord_clear(robot, target)
-    assert p.lengths is not None
+    assert p.path is not None and p.lengths is not None
     s_target, off = project(p.path, target, p.lengths)
     assert off == pytest.approx(0.0, abs=1e-9)  # a point of the path
     s_robot = project(p.path, robot, p.lengths)[0]
