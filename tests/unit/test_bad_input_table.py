@@ -160,6 +160,12 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("service --set an unknown parameter",
      lambda t: ["service", "perception", "--set", "nosuch=1"], 2,
      "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
+    ("bench bound --offsets not numbers", lambda t: ["bench", "bound", "--offsets", "left"], 2,
+     "zenav bench bound: argument --offsets: offsets must be numbers in m, got 'left'"),
+    ("bench bound --cases 0", lambda t: ["bench", "bound", "--cases", "0"], 2,
+     "zenav bench bound: --cases must be >= 1 (got 0)"),
+    ("bench bound --margin nan", lambda t: ["bench", "bound", "--margin", "nan"], 2,
+     "zenav bench bound: --margin must be >= 0 (got nan)"),
     ("params of an unknown planner", lambda t: ["params", "planner", "--planner", "foo"], 2,
      f"zenav params: no planner named 'foo'; the planners are {', '.join(PLANNERS)}"),
 ]

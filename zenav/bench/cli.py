@@ -1,11 +1,11 @@
-"""``zenav bench perf|nav|crowd|accuracy`` and ``zenav soak``: the benchmarks' commands (results
-in ``docs/benchmarks.md``)."""
+"""``zenav bench perf|nav|crowd|bound|accuracy`` and ``zenav soak``: the benchmarks'
+commands (results in ``docs/benchmarks.md``)."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from zenav.bench import crowd, nav, perf, soak, tracking_accuracy
+from zenav.bench import bound, crowd, nav, perf, soak, tracking_accuracy
 
 
 def add_commands(sub: Any) -> None:
@@ -15,5 +15,6 @@ def add_commands(sub: Any) -> None:
     perf.add_command(kinds)
     nav.add_command(kinds)
     crowd.add_command(kinds)
+    bound.add_command(kinds)
     tracking_accuracy.add_command(kinds)
     soak.add_command(sub)
