@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from zenav.cli import main
 from zenav.bench.bound import Limits, fastest_arrival, humans_paths, side_path
+from zenav.cli import main
 from zenav.sim.crowdnav import crowdnav_scenario
 
 LINE = np.array([[0.0, 0.0], [0.0, 8.0]])
