@@ -213,13 +213,15 @@ class Planner:
         if not statics or off_path < p.cell / 2:
             return default
         rejoin = self._rejoin_point(robot, statics)
-        if rejoin is None or project(self.path, rejoin, lengths)[0] < s0 + p.lookahead:
+        if rejoin is None:
+            return default
+        s_rejoin = project(self.path, rejoin, lengths)[0]
+        if s_rejoin < s0 + p.lookahead:
             return default
         if self._chord_clear(robot, rejoin):
             return rejoin
         # Clear of the boxes, not of what the map holds: the farthest point short of it
         # whose chord the map lets through, or the look-ahead point.
-        s_rejoin = project(self.path, rejoin, lengths)[0]
         s = s_rejoin - p.map_resolution
         while s > s0 + p.lookahead:
             point = point_at(self.path, s, lengths)
