@@ -893,7 +893,7 @@ class Planner:
         self.top_speeds.update({ob.id: max(self.top_speeds.get(ob.id, 0.0),
                                            math.hypot(*ob.velocity))
                                 for ob in obstacles if ob.kind == "dynamic"})
-        self.unseen = self.remember_movers(obstacles, stamp, scan)
+        self.unseen = self.remember_movers(obstacles, stamp, scan, pose[:2])
         dynamic = {ob.id for ob in obstacles if ob.kind == "dynamic"}
         self.top_speeds = {i: v for i, v in self.top_speeds.items()
                            if i in dynamic or (i in self.last_seen_movers and i not in live)}
@@ -1092,7 +1092,8 @@ class Planner:
     # -- the movers out of view --------------------------------------------------------
 
     def remember_movers(self, obstacles: list[Obstacle], stamp: float,
-                        scan: ScanData | None) -> list[tuple[Obstacle, float]]:
+                        scan: ScanData | None,
+                        robot: tuple[float, float] | None = None) -> list[tuple[Obstacle, float]]:
         """The movers whose tracks are lost, predicted at constant velocity to ``stamp``,
         each with the seconds since it was last seen. The 180-degree laser does not see
         beside and behind the robot: a crosser that leaves its view while the robot turns
@@ -1113,10 +1114,13 @@ class Planner:
                     kept[ob_id] = (ob, seen)
                 continue  # tracked, but no longer moving: the track says where it is
             age = stamp - seen
-            if age > p.mover_memory:
-                continue
             where = (ob.position[0] + ob.velocity[0] * age, ob.position[1] + ob.velocity[1] * age)
             reach = ob.radius + p.safety_growth * self.top_speeds.get(ob_id, 0.0) * age
+            # Past mover_memory a mover is forgotten unless it is still coming at the
+            # robot: a walker that follows it out of view is there until it has passed.
+            if age > p.mover_memory and (p.mover_memory <= 0.0 or robot is None
+                                         or not self._coming_at(ob, where, reach, robot)):
+                continue
             if scan is not None and should_be_seen(scan, where, ob.radius):
                 continue
             if any(self._same_mover(ob, o, where, reach) for o in moving):
@@ -1125,6 +1129,22 @@ class Planner:
             unseen.append((dataclasses.replace(ob, position=where), age))
         self.last_seen_movers = kept
         return unseen
+
+    def _coming_at(self, ob: Obstacle, where: tuple[float, float], reach: float,
+                   robot: tuple[float, float]) -> bool:
+        """Whether a mover predicted at ``where`` (its disc grown to ``reach``) still walks
+        toward the robot's place ``robot``, inside the window, on a line that passes it
+        closer than the clearance the planner keeps."""
+        p = self.p
+        dx, dy = robot[0] - where[0], robot[1] - where[1]
+        vx, vy = ob.velocity
+        speed = math.hypot(vx, vy)
+        if speed < 1e-9 or dx * vx + dy * vy <= 0.0:
+            return False  # standing, or past the robot
+        if math.hypot(dx, dy) - ob.radius > p.window_radius:
+            return False
+        across = abs(dx * vy - dy * vx) / speed
+        return across <= reach + p.robot_radius + p.safety_margin
 
     @staticmethod
     def _same_mover(lost: Obstacle, track: Obstacle, where: tuple[float, float],

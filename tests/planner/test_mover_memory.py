@@ -59,6 +59,7 @@ def test_a_remembered_mover_is_dropped_when_the_laser_should_see_it_and_does_not
 
 
 def test_a_remembered_mover_is_forgotten_after_mover_memory_seconds() -> None:
+    # The crosser walks across 1 m beside the robot: it does not come at the robot.
     p = planner(1.0)
     p.step((0.0, 0.0, 0.0), [CROSSER], 0.0, scan_of((0.0, 0.0, 0.0), discs=[(1.0, 1.3, 0.2)]))
     behind = (0.0, 0.0, math.radians(-120.0))
@@ -67,6 +68,25 @@ def test_a_remembered_mover_is_forgotten_after_mover_memory_seconds() -> None:
     assert p.unseen[0][0].position == (1.0, 1.3 - 0.6 * 0.5)
     p.step(behind, [], 1.1, scan_of(behind))
     assert p.unseen == []
+
+
+def test_a_walker_that_follows_the_robot_out_of_view_is_not_forgotten_by_age() -> None:
+    # The robot flees a walker head-on down a corridor, its back to it, as fast as the
+    # walker comes: the walker stays 1.5 m behind, out of the laser's view, for longer
+    # than mover_memory. When the robot stops, it must still know the walker is there.
+    # A walker on a line 1 m to the side is forgotten as before.
+    for lateral, remembered in ((0.1, [7]), (1.0, [])):
+        p = planner(2.0)
+        walker = Obstacle(7, "dynamic", (1.5, lateral), (-0.3, 0.0), 0.2, (2, 2, 2, 2))
+        p.step((0.0, 0.0, 0.0), [walker], 0.0,
+               scan_of((0.0, 0.0, 0.0), discs=[(1.5, lateral, 0.2)]))
+        for k in range(1, 41):  # 4 s, fleeing west at 0.3 m/s
+            t = 0.1 * k
+            pose = (-0.3 * t, 0.0, math.pi)
+            p.step(pose, [], t, scan_of(pose))
+        assert [ob.id for ob, _ in p.unseen] == remembered
+        for ob, age in p.unseen:  # where it is predicted: 0.3 m behind the robot's back
+            assert math.isclose(age, 4.0) and math.isclose(ob.position[0], 1.5 - 0.3 * 4.0)
 
 
 def test_another_walker_near_its_predicted_place_does_not_make_it_seen_again() -> None:
