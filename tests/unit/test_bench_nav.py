@@ -10,8 +10,8 @@ from typing import Any
 
 import pytest
 
-from zenav.bench.nav import goal_lines, still_at_end, summarise, write_worlds
-from zenav.sim.scenario import load_scenario
+from zenav.bench.nav import goal_lines, never_in_view, still_at_end, summarise, write_worlds
+from zenav.sim.scenario import Scenario, load_scenario
 
 
 def test_fov_changes_only_the_laser(tmp_path: Path) -> None:
@@ -69,6 +69,41 @@ def test_the_goal_is_met_when_every_family_reaches_the_target() -> None:
     (paper,), families = summarise(records, ["paper"])
     assert paper.stuck == []
     assert goal_lines([paper], families).endswith("stood still: 0 (met).")
+
+
+def walker_world(velocity: tuple[float, float], start: float = -3.0) -> Scenario:
+    """The robot drives east along y = 0 at 1 m/s from x = 0 (180-degree laser, 8 m); one
+    walker starts at (``start``, 0)."""
+    return Scenario.model_validate({
+        "name": "walker", "world": {"size": [20.0, 10.0], "cell": 0.5},
+        "robot": {"start": [0.0, 0.0], "goal": [15.0, 0.0], "speed": 1.0, "max_speed": 1.0,
+                  "radius": 0.3},
+        "obstacles": [{"shape": "box", "center": [18.0, 8.0], "size": [0.5, 0.5]},
+                      {"shape": "disc", "center": [start, 0.0], "radius": 0.3,
+                       "velocity": list(velocity)}],
+        "duration": 30.0})
+
+
+def test_a_hit_from_behind_by_a_walker_never_in_the_field_of_view_is_told_apart() -> None:
+    driving = [[k / 10, k / 10, 0.0, 0.0, 1.0] for k in range(25)]  # 0-2.4 s, east
+    hit = {**record("crowd-1", "collision", driving), "collided_with": 1}
+    # Overtaking at 2 m/s from behind: always behind the robot, never in its field.
+    assert never_in_view(walker_world((2.0, 0.0)), hit)
+    # The same collision index, but the walker came from ahead (head-on): it was seen.
+    assert not never_in_view(walker_world((-2.0, 0.0), start=8.0), hit)
+    # Not a collision: nothing to tell.
+    assert not never_in_view(walker_world((2.0, 0.0)), {**hit, "outcome": "timeout"})
+    # An ORCA agent is placed by the record's rows: these put it ahead of the robot once.
+    rows = [[t, x - 3.0, 0.0] for t, x, *_ in driving]
+    rows[5] = [0.5, 2.0, 0.0]
+    assert not never_in_view(walker_world((2.0, 0.0)), {**hit, "agents": {"1": rows}})
+    assert never_in_view(walker_world((0.0, 0.0)), {**hit, "agents": {
+        "1": [[t, x - 1.0, 0.0] for t, x, *_ in driving]}})
+    (paper,), families = summarise([hit, record("crowd-2", "reached", driving)], ["paper"],
+                            unseen_hit=lambda r: never_in_view(walker_world((2.0, 0.0)), r))
+    assert paper.hit_unseen == ["crowd-1"] and paper.collisions == 1
+    assert ("Collisions with an obstacle never in the laser's field of view: 1 of 1 "
+            "(crowd-1).") in goal_lines([paper], families)
 
 
 @pytest.mark.parametrize("reuse", [False, True])

@@ -78,6 +78,7 @@ class PlannerSummary:
     median_clearance: float
     decisions: float  # planner events per run
     stuck: list[str]  # runs not reached that ended standing > STILL_LIMIT with a way known
+    hit_unseen: list[str]  # collisions with an obstacle never in the laser's field
 
     def rate(self, count: int) -> float:
         return count / self.runs if self.runs else math.nan
@@ -101,11 +102,40 @@ def still_at_end(trajectory: Sequence[Sequence[float]]) -> float:
     return float(t_end - since)
 
 
+def never_in_view(scenario: Scenario, record: dict[str, Any]) -> bool:
+    """Whether the run ended in contact with an obstacle whose centre was never inside
+    the laser's field (within ``fov_deg / 2`` of the heading and ``max_range``) at any
+    tick of the run. Occlusion is ignored, so this is what the laser could not have seen
+    even with nothing in the way. ORCA agents are placed by the record's own rows."""
+    index = record.get("collided_with")
+    trajectory = record.get("trajectory") or []
+    if record.get("outcome") != "collision" or index is None or not trajectory:
+        return False
+    half = math.radians(scenario.laser.fov_deg) / 2
+    reach = scenario.laser.max_range
+    ob = scenario.obstacles[index]
+    rows = record.get("agents", {}).get(str(index))
+    for k, (t, x, y, heading, _) in enumerate(trajectory):
+        if rows is not None:
+            cx, cy = rows[k][1], rows[k][2]
+        else:
+            if not ob.appear <= t < ob.vanish_time:
+                continue
+            cx = ob.center[0] + ob.velocity[0] * (t - ob.appear)
+            cy = ob.center[1] + ob.velocity[1] * (t - ob.appear)
+        bearing = math.remainder(math.atan2(cy - y, cx - x) - heading, math.tau)
+        if abs(bearing) <= half and math.hypot(cx - x, cy - y) <= reach:
+            return False
+    return True
+
+
 def summarise(records: list[dict[str, Any]], planners: Sequence[str],
               has_way: Callable[[str], bool] = lambda name: True,
+              unseen_hit: Callable[[dict[str, Any]], bool] = lambda record: False,
               ) -> tuple[list[PlannerSummary], dict[str, dict[str, float]]]:
     """Per planner and per family; ``has_way``: whether a world (by name) has a way for
-    the robot's disc on its static geometry (a run stuck there was the planner's)."""
+    the robot's disc on its static geometry (a run stuck there was the planner's);
+    ``unseen_hit``: whether a run ended hit by something its laser never had in view."""
     by_planner: dict[str, list[dict[str, Any]]] = {p: [] for p in planners}
     for r in records:
         by_planner.setdefault(r["planner"], []).append(r)
@@ -137,6 +167,8 @@ def summarise(records: list[dict[str, Any]], planners: Sequence[str],
                    if r["outcome"] not in ("reached", "collision")
                    and still_at_end(r.get("trajectory", [])) > STILL_LIMIT
                    and has_way(r["scenario"])],
+            hit_unseen=[r["scenario"] for r in valid
+                        if r["outcome"] == "collision" and unseen_hit(r)],
         ))
     families: dict[str, dict[str, float]] = {}
     for p in planners:
@@ -161,16 +193,18 @@ def num(value: float, digits: int = 1) -> str:
 def tables(summaries: list[PlannerSummary], families: dict[str, dict[str, float]]) -> str:
     common = summaries[0].common if summaries else 0
     lines = [
-        "| planner | runs | success | collision | timeout | stood still at the end† | "
+        "| planner | runs | success | collision | … by a mover never in view‡ | timeout | "
+        "stood still at the end† | "
         "mean time to goal s* | mean path m* | min clearance m (worst / median) | "
         "decisions per run |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for s in summaries:
         errors = f" (+{s.errors} failed)" if s.errors else ""
         lines.append(
             f"| {s.planner} | {s.runs}{errors} | {pct(s.reached, s.runs)} | "
-            f"{pct(s.collisions, s.runs)} | {pct(s.timeouts, s.runs)} | {len(s.stuck)} | "
+            f"{pct(s.collisions, s.runs)} | {len(s.hit_unseen)} | {pct(s.timeouts, s.runs)} | "
+            f"{len(s.stuck)} | "
             f"{num(s.mean_time)} | "
             f"{num(s.mean_path, 2)} | {num(s.min_clearance, 3)} / {num(s.median_clearance, 3)} | "
             f"{num(s.decisions)} |")
@@ -179,7 +213,10 @@ def tables(summaries: list[PlannerSummary], families: dict[str, dict[str, float]
                  "without a collision. † runs that did not reach the goal and ended with "
                  f"the robot standing (within {STILL_RADIUS:g} m) for more than "
                  f"{STILL_LIMIT:g} s in a world where its disc has a way round the static "
-                 "obstacles (a flood fill).")
+                 "obstacles (a flood fill). ‡ collisions (a count) with an obstacle whose "
+                 "centre was never within the laser's field of view and range at any tick "
+                 "of the run, occlusion aside: no planner that acts on the scans could "
+                 "have known of it.")
     planners = [s.planner for s in summaries]
     lines += ["", "| family | " + " | ".join(f"{p}: success (collisions)" for p in planners)
               + " |", "|---|" + "---|" * len(planners)]
@@ -214,6 +251,10 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
              + f"; stood still: {len(paper.stuck)}"
              + (f" ({', '.join(paper.stuck)})" if paper.stuck else "")
              + f" ({'met' if met else 'NOT met'})."]
+    if paper.collisions:
+        lines.append("Collisions with an obstacle never in the laser's field of view: "
+                     f"{len(paper.hit_unseen)} of {paper.collisions}"
+                     + (f" ({', '.join(paper.hit_unseen)})" if paper.hit_unseen else "") + ".")
     others = [s for s in summaries if s.planner != "paper"]
     if others:
         ahead = all(paper.rate(paper.reached) > s.rate(s.reached) for s in others)
@@ -302,7 +343,12 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     def has_way(name: str) -> bool:
         return name not in world_files or solvable(load_scenario(world_files[name]))
 
-    summaries, per_family = summarise(records, planners, has_way)
+    def unseen_hit(record: dict[str, Any]) -> bool:
+        name = record["scenario"]
+        return (record["outcome"] == "collision" and name in world_files
+                and never_in_view(load_scenario(world_files[name]), record))
+
+    summaries, per_family = summarise(records, planners, has_way, unseen_hit)
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
                                    f" --families {','.join(families)}")
