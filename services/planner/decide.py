@@ -1093,7 +1093,7 @@ class Planner:
 
     def remember_movers(self, obstacles: list[Obstacle], stamp: float,
                         scan: ScanData | None,
-                        robot: tuple[float, float] | None = None) -> list[tuple[Obstacle, float]]:
+                        robot: tuple[float, float]) -> list[tuple[Obstacle, float]]:
         """The movers whose tracks are lost, predicted at constant velocity to ``stamp``,
         each with the seconds since it was last seen. The 180-degree laser does not see
         beside and behind the robot: a crosser that leaves its view while the robot turns
@@ -1118,7 +1118,7 @@ class Planner:
             reach = ob.radius + p.safety_growth * self.top_speeds.get(ob_id, 0.0) * age
             # Past mover_memory a mover is forgotten unless it is still coming at the
             # robot: a walker that follows it out of view is there until it has passed.
-            if age > p.mover_memory and (p.mover_memory <= 0.0 or robot is None
+            if age > p.mover_memory and (p.mover_memory <= 0.0
                                          or not self._coming_at(ob, where, reach, robot)):
                 continue
             if scan is not None and should_be_seen(scan, where, ob.radius):

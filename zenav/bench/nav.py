@@ -27,6 +27,7 @@ from zenav import argtypes
 from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch, verified_note
 from zenav.bench.common import machine, words
 from zenav.engine import ENGINES
+from zenav.services.geometry import wrap_angle
 from zenav.sim.generate import FAMILIES, random_scenario
 from zenav.sim.scenario import Scenario, dump_scenario, load_scenario
 from zenav.sim.unseen import CLASSES, FAMILY_PREFIX, solvable, unseen_scenario
@@ -118,12 +119,11 @@ def never_in_view(scenario: Scenario, record: dict[str, Any]) -> bool:
     for k, (t, x, y, heading, _) in enumerate(trajectory):
         if rows is not None:
             cx, cy = rows[k][1], rows[k][2]
+        elif ob.exists_at(t):
+            cx, cy = ob.center_at(t)
         else:
-            if not ob.appear <= t < ob.vanish_time:
-                continue
-            cx = ob.center[0] + ob.velocity[0] * (t - ob.appear)
-            cy = ob.center[1] + ob.velocity[1] * (t - ob.appear)
-        bearing = math.remainder(math.atan2(cy - y, cx - x) - heading, math.tau)
+            continue
+        bearing = wrap_angle(math.atan2(cy - y, cx - x) - heading)
         if abs(bearing) <= half and math.hypot(cx - x, cy - y) <= reach:
             return False
     return True
