@@ -37,7 +37,7 @@ def test_an_inprocess_sweep_is_verified_by_the_stack(tmp_path: Path) -> None:
 
 def test_ctrl_c_stops_the_workers_within_a_second(tmp_path: Path) -> None:
     command = [sys.executable, "-m", "zenav", "bench", "nav", "--planners", "paper",
-               "--worlds", "6", "--families", "static", "--jobs", "2", "--verify", "0",
+               "--worlds", "40", "--families", "static", "--jobs", "2", "--verify", "0",
                "--no-progress", "--out", str(tmp_path)]
     with sigint_as_usual():
         proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -48,7 +48,8 @@ def test_ctrl_c_stops_the_workers_within_a_second(tmp_path: Path) -> None:
         assert time.monotonic() < deadline, "the workers did not start"
         time.sleep(0.2)
     family = parent.children(recursive=True)
-    time.sleep(2.0)  # the workers are in their runs
+    time.sleep(2.0)  # the workers are in their runs (40 worlds: a minute of work)
+    assert proc.poll() is None, "the benchmark ended before Ctrl-C was sent"
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
 
