@@ -575,6 +575,17 @@ class Planner:
         """Check driving toward ``target`` at ``speed`` against every mover as the robot
         would drive it (``safety.py``); the local layer's command if it is safe, else the
         nearest safe heading and speed."""
+        robot, group, heading, blocked = self._safety_inputs(pose, target, movers, ages)
+        carrot = self._carrot(np.array(pose[:2], dtype=np.float64), path_target)
+        return safety.choose(robot, (heading, speed), group, carrot, blocked,
+                             self.safety_heading, self.safety_settings)
+
+    def _safety_inputs(
+        self, pose: tuple[float, float, float], target: Vec, movers: list[Obstacle],
+        ages: list[float] | None,
+    ) -> tuple[safety.Robot, safety.Movers, float, safety.Blocked | None]:
+        """The robot, the movers, the heading to ``target`` and the map's check, as the
+        speed and safety stage takes them."""
         p = self.p
         robot = safety.Robot(
             x=pose[0], y=pose[1], heading=pose[2], speed=self.last_v,
@@ -587,10 +598,26 @@ class Planner:
             np.array([self.top_speeds.get(o.id, 0.0) for o in movers], dtype=np.float64),
             None if ages is None else np.asarray(ages, dtype=np.float64))
         heading = math.atan2(target[1] - pose[1], target[0] - pose[0])
-        carrot = self._carrot(np.array(pose[:2], dtype=np.float64), path_target)
         blocked = self.costmap.blocked_rows if self.costmap is not None else None
-        return safety.choose(robot, (heading, speed), group, carrot, blocked,
-                             self.safety_heading, self.safety_settings)
+        return robot, group, heading, blocked
+
+    def clear_at_cruise(self, pose: tuple[float, float, float], target: Vec,
+                        walkers: list[Obstacle], ages: list[float]) -> bool:
+        """Whether driving on toward ``target`` at V_R keeps clear of every walker (and
+        of the map) over the safety stage's horizon, each walker's clearance grown
+        ``drive_on_growth`` times as fast as the stage's own. The paper's (e) answers
+        one predicted meeting on a straight line; in a crowd many of the stops it asks
+        for leave the way ahead free (docs/navigation.md, "Driving on when the way is
+        clear")."""
+        p = self.p
+        if not p.speed_check or p.drive_on_growth <= 0.0:
+            return False
+        if float(np.hypot(*(target - np.asarray(pose[:2], dtype=np.float64)))) <= 1e-9:
+            return False
+        robot, group, heading, blocked = self._safety_inputs(pose, target, walkers, ages)
+        wary = dataclasses.replace(self.safety_settings,
+                                   growth=self.safety_settings.growth * p.drive_on_growth)
+        return safety.keeps_clear(robot, (heading, p.cruise_speed), group, blocked, wary)
 
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far
@@ -823,6 +850,16 @@ class Planner:
         # Then the movers out of view, predicted from where they were last seen.
         walkers = [o for o in in_window if o.kind == "dynamic"] + [o for o, _ in unseen]
         ages = [0.0] * (len(walkers) - len(unseen)) + [age for _, age in unseen]
+        # (e) asks for a stop or a lower speed on one predicted meeting at a time; when
+        # the way ahead at V_R is free of every walker after all, the robot drives on.
+        # Only for meetings the roll-out covers (both at the crossing within its
+        # horizon), and not for (g), whose gap keeping is a speed law, not an answer.
+        if (responses and action in ("stop", "slow") and not needs_detour
+                and self.detour is None
+                and all(a.letter == "e" and max(a.robot_time, a.obstacle_time)
+                        <= p.safety_horizon for _, _, a in responses)
+                and self.clear_at_cruise(pose, target, walkers, ages)):
+            speed, action = p.cruise_speed, "keep"
         self.safety_heading = None if not (movers or unseen) else self.safety_heading
         if p.speed_check and (movers or unseen) and float(np.hypot(*(target - robot))) > 1e-9:
             choice = self.speed_and_safety(pose, target, speed, walkers, path_target, ages)

@@ -126,6 +126,13 @@ class Params(MissionParams, StopZoneParams):
         "this long, s, and past it while it still walks at the robot; dropped at once "
         "when it should be in view and is not (0: never)"
     )
+    drive_on_growth: float = Field(
+        2.0, ge=0, description="when the (e) responses ask for a stop or a lower speed "
+        "and no detour is under way, the robot drives on at V_R if the speed and safety "
+        "stage's roll-out at V_R toward the target keeps clear of every mover, seen or "
+        "remembered, with safety_growth times this factor; 0: the responses stand (as "
+        "with speed_check off)"
+    )
     accel: float = Field(ACCEL, gt=0, description="forward acceleration limit of the "
                          "commands (the motor bridge's), m/s^2")
 

@@ -159,13 +159,10 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     the point on the global path progress is measured to; ``blocked``: which roll-outs
     pass a point the map holds (None: no map)."""
     heading, speed = proposal
-    steps = max(round(s.horizon / s.step), 1)
-    times = s.step * np.arange(1, steps + 1, dtype=np.float64)
+    times = _times(s)
     # The proposal alone first: most cycles keep it, and the fan's roll-outs (the same
     # numbers for the proposal, row by row) are needed only when it is not safe.
-    _, _, cost, first_t, _ = _score(robot, np.array([heading]), np.array([speed]), times,
-                                    movers, blocked, s)
-    if math.isinf(first_t[0]) and cost[0] < 10.0:
+    if keeps_clear(robot, proposal, movers, blocked, s):
         return Choice(heading, speed, True, math.inf, None)
     fan = np.arange(-math.pi, math.pi, s.fan_step)
     headings = np.concatenate(([heading], np.repeat(heading + fan, len(s.speeds))))
@@ -180,6 +177,21 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     culprit = int(who[0]) if who[0] >= 0 else None
     return Choice(wrap_angle(float(headings[best])), float(speeds[best]),
                   best == 0, float(first_t[best]), culprit)
+
+
+def keeps_clear(robot: Robot, proposal: tuple[float, float], movers: Movers,
+                blocked: Blocked | None, s: Settings) -> bool:
+    """Whether the roll-out of ``proposal`` (heading rad, speed m/s) touches no mover and
+    nothing the map holds within the horizon."""
+    _, _, cost, first_t, _ = _score(robot, np.array([proposal[0]]), np.array([proposal[1]]),
+                                    _times(s), movers, blocked, s)
+    return bool(math.isinf(first_t[0]) and cost[0] < 10.0)
+
+
+def _times(s: Settings) -> Vec:
+    """The roll-out times: every ``step`` s from one step to the horizon."""
+    steps = max(round(s.horizon / s.step), 1)
+    return s.step * np.arange(1, steps + 1, dtype=np.float64)
 
 
 def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,

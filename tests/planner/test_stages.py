@@ -88,6 +88,29 @@ def test_e_a_crosser_that_would_meet_the_robot_changes_its_speed() -> None:
     assert d.speed != pytest.approx(0.1)
 
 
+CROWD_ROBOT = {"cruise_speed": 1.0, "max_speed": 1.0, "robot_radius": 0.3}
+
+
+def test_e_a_stop_for_a_crosser_already_leaving_the_way_gives_way_to_driving_on() -> None:
+    # Just ahead, going off the robot's line at 1.2 m/s: the paper's (e) sees the robot
+    # and the crosser in the crossing zone together and stops; the roll-out at V_R
+    # (from standstill, within the acceleration limit) finds the way free.
+    leaving = [mover(1, 3.25, 2.5, 0.0, 1.2, 0.3)]
+    paper_answer = decide(planner(drive_on_growth=0.0, **CROWD_ROBOT), leaving, (0.0,))
+    assert (paper_answer.scenario, paper_answer.action) == ("e", "stop")
+    d = decide(planner(**CROWD_ROBOT), leaving, (0.0,))
+    assert (d.scenario, d.action) == ("e", "keep")
+    assert d.speed == pytest.approx(1.0) and d.v > 0.0
+
+
+@pytest.mark.parametrize(("x", "y", "vy"), [(4.0, 1.5, 0.5), (4.5, 1.0, 1.0), (5.0, 2.0, 0.3)])
+def test_e_a_crosser_the_robot_would_meet_still_stops_or_slows_it(x: float, y: float,
+                                                                   vy: float) -> None:
+    d = decide(planner(**CROWD_ROBOT), [mover(1, x, y, 0.0, vy, 0.3)], (0.0,))
+    assert d.scenario == "e" and d.action in {"stop", "slow"}
+    assert d.speed < 1.0
+
+
 def test_f_a_mover_coming_head_on_is_gone_round_with_morphin() -> None:
     d = decide(planner(), [mover(1, 5.0, 3.0, -0.2, 0.0)], stamps=(0.0,))
     assert (d.scenario, d.action) == ("f", "morphin")
