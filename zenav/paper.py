@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from zenav import argtypes
 from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch
 from zenav.engine import ENGINES
 from zenav.services.mission import window_radius
@@ -409,7 +410,8 @@ def _command(args: argparse.Namespace) -> int:
 
 def add_command(sub: Any) -> None:
     paper = sub.add_parser("paper", help="reproduce the paper's experiments as a report")
-    paper.add_argument("--out", type=Path, default=Path("out/paper"), help="report directory")
+    paper.add_argument("--out", type=argtypes.path, default=Path("out/paper"),
+                       help="report directory (default out/paper)")
     paper.add_argument("--quick", action="store_true",
                        help="scenario (a) once per profile only (a smoke test of the report)")
     paper.add_argument("--jobs", "--parallel", dest="parallel", type=int,

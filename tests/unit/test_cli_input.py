@@ -147,15 +147,20 @@ def test_a_huge_set_is_quoted_short(capsys: pytest.CaptureFixture[str]) -> None:
 # --- paths ---------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("argv", [["run", str(SCENARIO), "--out", ""], ["schemas", "--out", ""]],
-                         ids=["run", "schemas"])
+EMPTY_OUT = [["run", str(SCENARIO), "--out", ""], ["schemas", "--out", ""],
+             ["paper", "--quick", "--out", ""], ["bench", "nav", "--out", ""],
+             ["bench", "crowd", "--out", ""], ["bench", "bound", "--out", ""]]
+
+
+@pytest.mark.parametrize("argv", EMPTY_OUT, ids=[" ".join(a[:2]) for a in EMPTY_OUT])
 def test_an_empty_out_path_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                       monkeypatch: pytest.MonkeyPatch, argv: list[str]) -> None:
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_:
         zenav_main(argv)
     assert exit_.value.code == 2
-    assert one_line(capsys) == f"zenav {argv[0]}: argument --out: the path is empty"
+    command = " ".join(argv[:2]) if argv[0] == "bench" else argv[0]
+    assert one_line(capsys) == f"zenav {command}: argument --out: the path is empty"
     assert list(tmp_path.iterdir()) == []
 
 
@@ -326,6 +331,8 @@ BAD_NUMBERS = [
     (["soak", "--max-growth", "nan"], "zenav soak: argument --max-growth: must be a finite "
      "number (got nan)"),
     (["bench", "nav", "--seed", "-1"], "zenav bench nav: argument --seed: must be >= 0 "
+     "(got -1)"),
+    (["bench", "crowd", "--seed", "-1"], "zenav bench crowd: argument --seed: must be >= 0 "
      "(got -1)"),
 ]
 

@@ -25,12 +25,12 @@ import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
+from zenav import argtypes
 from zenav.bench.common import machine, words
 from zenav.services.mission import ACCEL, DECEL
 from zenav.sim.agents import Crowd
@@ -235,6 +235,6 @@ def add_command(kinds: Any) -> None:
                        help="gap kept beyond the two radii at every tick, m (default 0)")
     bound.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                        help="cases at a time (default: the number of cores)")
-    bound.add_argument("--out", type=Path, default=None,
+    bound.add_argument("--out", type=argtypes.path, default=None,
                        help="also write bound.md and bound.json here")
     bound.set_defaults(func=_command)

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from zenav import argtypes
 from zenav.batch import DEFAULT_VERIFY, Job, Records, run_batch, verified_note
 from zenav.bench.common import machine, words
 from zenav.sim.crowdnav import (
@@ -332,12 +333,12 @@ def add_command(kinds: Any) -> None:
     crowd.add_argument("--settings", default=",".join(SETTINGS),
                        help="comma-separated settings LAYOUT-VISIBILITY-FOV (default all "
                        f"eight: {','.join(SETTINGS)})")
-    crowd.add_argument("--seed", type=int, default=0,
+    crowd.add_argument("--seed", type=argtypes.non_negative_int, default=0,
                        help="first CrowdNav test case (default 0)")
     crowd.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                       help="runs at a time (default: the number of cores; each run is six "
-                       "processes)")
-    crowd.add_argument("--engine", default="inprocess",
+                       help="runs at a time (default: the number of cores; with the stack "
+                       "engine each run is six processes)")
+    crowd.add_argument("--engine", choices=ENGINES, default="inprocess",
                        help=f"how each run is made: {', '.join(ENGINES)} (default "
                        "inprocess: the services in one process per run, --verify cases made "
                        "again through the stack and compared; stack: every run through "
@@ -345,7 +346,7 @@ def add_command(kinds: Any) -> None:
     crowd.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
                        help="in-process runs re-made through the stack and compared tick by "
                        f"tick (default {DEFAULT_VERIFY})")
-    crowd.add_argument("--out", type=Path, default=Path("out/bench-crowd"),
+    crowd.add_argument("--out", type=argtypes.path, default=Path("out/bench-crowd"),
                        help="directory for the cases, runs, crowd.md, crowd.png, crowd.json")
     crowd.add_argument("--reuse", action="store_true",
                        help="take a run.json already under --out as that run's record "

@@ -401,7 +401,7 @@ def add_command(kinds: Any) -> None:
     nav.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
                      help=f"in-process runs re-made through the stack and compared tick by "
                      f"tick (default {DEFAULT_VERIFY})")
-    nav.add_argument("--out", type=Path, default=Path("out/bench-nav"),
+    nav.add_argument("--out", type=argtypes.path, default=Path("out/bench-nav"),
                      help="directory for the worlds, runs, nav.md, nav.png, nav.json")
     nav.add_argument("--fov", type=float, default=None,
                      help="every world's laser field of view, degrees (default: each "
