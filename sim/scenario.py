@@ -28,6 +28,7 @@ from pydantic import (
 )
 
 from zenav.services.inputs import AliasError, BoundedLoader, safe_load, shown, yaml_problem
+from zenav.services.mission import WINDOW_CELLS
 
 __all__ = [
     "LaserSpec",
@@ -40,10 +41,15 @@ __all__ = [
     "parse_scenario",
 ]
 
-# Numbers must be numbers in the file (no "1.0" strings, no booleans), finite.
-Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]
-Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0)]
-NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0)]
+MAGNITUDE = 1e6
+"""The largest number a scenario may hold (m, s, m/s, degrees): beyond it the simulator's
+arithmetic overflows long before a run could mean anything."""
+
+# Numbers must be numbers in the file (no "1.0" strings, no booleans), finite, and within
+# +-MAGNITUDE.
+Number = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-MAGNITUDE, le=MAGNITUDE)]
+Positive = Annotated[float, Field(strict=True, allow_inf_nan=False, gt=0, le=MAGNITUDE)]
+NonNegative = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=0, le=MAGNITUDE)]
 Point = tuple[Number, Number]
 
 NAME_PATTERN = r"^[a-z0-9-]+$"
@@ -358,7 +364,16 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
     if ticks > MAX_TICKS:
         problems.append((("duration",), f"at most {MAX_TICKS} simulator ticks (got "
                          f"{ticks:.0f}: duration x max(laser.rate_hz, 10))"))
+    if scenario.laser.max_range < scenario.world.cell:
+        problems.append((("laser", "max_range"), f"must be at least world.cell "
+                         f"({scenario.world.cell:g} m): the perception window reaches "
+                         f"{WINDOW_CELLS} cells but no farther than the laser, and must hold "
+                         f"a cell (got {scenario.laser.max_range:g} m)"))
     robot = scenario.robot
+    if robot.effective_max_speed < robot.speed:
+        problems.append((("robot", "max_speed"), f"must be at least robot.speed "
+                         f"({robot.speed:g} m/s, the cruise speed; got "
+                         f"{robot.effective_max_speed:g} m/s)"))
     for i, obstacle in enumerate(scenario.obstacles):
         if count > MAX_OBSTACLES:
             break  # the count is the problem; one line, not a thousand

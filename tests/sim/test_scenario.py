@@ -250,6 +250,15 @@ BAD_CASES: list[tuple[str, Edit, str]] = [
     ("goal-in-static-box", set_at("obstacles.0.center", [8.2, 5.1]), "robot.goal: inside static"),
     ("negative-seed", set_at("seed", -1), "seed: must be >= 0"),
     ("zero-duration", set_at("duration", 0), "duration: must be > 0"),
+    ("huge-velocity", set_at("obstacles.1.velocity", [1e308, 0.0]),
+     "obstacles[1].velocity[0]: must be <= 1e+06 (got 1e+308)"),
+    ("huge-speed", set_at("robot.speed", 1e300), "robot.speed: must be <= 1e+06 (got 1e+300)"),
+    ("far-centre", set_at("obstacles.1.center", [-1e308, 3.0]),
+     "obstacles[1].center[0]: must be >= -1e+06 (got -1e+308)"),
+    ("cell-beyond-the-laser", set_at("laser", {"max_range": 0.1}),
+     "laser.max_range: must be at least world.cell (0.5 m)"),
+    ("top-speed-below-cruise", set_at("robot.max_speed", 0.05),
+     "robot.max_speed: must be at least robot.speed"),
 ]
 
 

@@ -140,6 +140,24 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
          {"shape": "disc", "center": [1.0, 1.0 + 1e-4 * i], "radius": 0.05}
          for i in range(10_000)])), "--out", str(t / "o")], 2,
      f"zenav run: {{t}}/many.yaml: obstacles: at most {MAX_OBSTACLES} obstacles (got 10000)"),
+    ("run an obstacle faster than any number a scenario may hold",
+     lambda t: ["run", str(scenario_with(t, "fast", obstacles=[
+         {"shape": "disc", "center": [5.0, 1.0], "radius": 0.2, "velocity": [1e308, 0.0]}])),
+                "--out", str(t / "o")], 2,
+     "zenav run: {t}/fast.yaml: obstacles[0].velocity[0]: must be <= 1e+06 (got 1e+308)"),
+    ("run a grid cell larger than the laser reaches",
+     lambda t: ["run", str(scenario_with(t, "big", world__cell=10.0)), "--out", str(t / "o")],
+     2, "zenav run: {t}/big.yaml: laser.max_range: must be at least world.cell (10 m): the "
+     "perception window reaches 8 cells but no farther than the laser, and must hold a cell "
+     "(got 8 m)"),
+    ("run a top speed below the cruise speed",
+     lambda t: ["run", str(scenario_with(t, "slow", robot__max_speed=0.05)),
+                "--out", str(t / "o")], 2,
+     "zenav run: {t}/slow.yaml: robot.max_speed: must be at least robot.speed (0.1 m/s, the "
+     "cruise speed; got 0.05 m/s)"),
+    ("bench crowd --seed below zero",
+     lambda t: ["bench", "crowd", "--seed", "-1", "--out", str(t / "o")], 2,
+     "zenav bench crowd: argument --seed: must be >= 0 (got -1)"),
     ("run a goal the robot disc cannot stand on",
      lambda t: ["run", str(scenario_with(t, "goal", obstacles=[
          {"shape": "box", "center": [8.35, 3.0], "size": [0.5, 0.5]}])), "--out", str(t / "o")],
