@@ -18,11 +18,32 @@ is the robot's outage (15-25 s against 4.5 s on a loaded 2-core machine); ``run`
 benchmarks repeat, and that second was a fifth of a whole run."""
 
 
-def build_light_parser(command: str) -> argparse.ArgumentParser:
-    """The parser of one of the :data:`LIGHT` commands only."""
+def _top_parser() -> argparse.ArgumentParser:
+    from importlib.metadata import version
+
     from zenav.services.inputs import OneLineParser
 
     parser = OneLineParser(prog="zenav", description="Mobile-robot navigation as Zenoh services.")
+    parser.add_argument("--version", action="version", version=f"zenav {version('zenav')}")
+    return parser
+
+
+def _describe(parser: argparse.ArgumentParser) -> None:
+    """Give every subcommand without a description its one-line help as one, so that
+    ``zenav CMD --help`` says what CMD is for (recursively: ``zenav bench nav``)."""
+    for action in parser._actions:
+        if not isinstance(action, argparse._SubParsersAction):
+            continue
+        helps = {choice.dest: choice.help for choice in action._choices_actions}
+        for name, child in action.choices.items():
+            if child.description is None and helps.get(name):
+                child.description = helps[name]
+            _describe(child)
+
+
+def build_light_parser(command: str) -> argparse.ArgumentParser:
+    """The parser of one of the :data:`LIGHT` commands only."""
+    parser = _top_parser()
     sub = parser.add_subparsers(dest="command", required=True)
     if command == "router":
         from zenav.deploy import router
@@ -32,6 +53,7 @@ def build_light_parser(command: str) -> argparse.ArgumentParser:
         from zenav import stackcmd
 
         stackcmd.add_commands(sub)  # run, service, schemas
+    _describe(parser)
     return parser
 
 
@@ -43,9 +65,8 @@ def build_parser() -> argparse.ArgumentParser:
     from zenav.deploy import router
     from zenav.foxglove import live as foxglove_live
     from zenav.monitor import command as monitor
-    from zenav.services.inputs import OneLineParser
 
-    parser = OneLineParser(prog="zenav", description="Mobile-robot navigation as Zenoh services.")
+    parser = _top_parser()
     sub = parser.add_subparsers(dest="command", required=True)
     stackcmd.add_commands(sub)  # run, service, schemas
 
@@ -60,6 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     rviz.add_command(sub)
     foxglove_live.add_command(sub)
     bench.add_commands(sub)  # bench perf|nav|accuracy, soak
+    _describe(parser)
     return parser
 
 

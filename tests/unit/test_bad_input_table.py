@@ -155,6 +155,10 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
                 "--out", str(t / "o")], 2,
      "zenav run: {t}/slow.yaml: robot.max_speed: must be at least robot.speed (0.1 m/s, the "
      "cruise speed; got 0.05 m/s)"),
+    ("bench perf with no sections",
+     lambda t: ["bench", "perf", "--sections", "", "--out", str(t / "o")], 2,
+     "zenav bench perf: --sections is empty; choose from compute, latency, lockstep, engine, "
+     "rate"),
     ("bench crowd --seed below zero",
      lambda t: ["bench", "crowd", "--seed", "-1", "--out", str(t / "o")], 2,
      "zenav bench crowd: argument --seed: must be >= 0 (got -1)"),

@@ -7,6 +7,7 @@ process; none opens a Zenoh session."""
 
 from __future__ import annotations
 
+import argparse
 import time
 from pathlib import Path
 
@@ -354,3 +355,22 @@ def test_the_benchmarks_defaults_pass_their_own_checks() -> None:
     assert perf.obstacles == (0, 5, 20) and perf.rates == (10, 50, 100, 200, 300, 400, 600)
     soak = build_parser().parse_args(["soak"])
     assert (soak.minutes, soak.rate_hz, soak.warmup, soak.window) == (30.0, 100.0, 30.0, 60.0)
+
+
+def test_version_and_every_subcommand_says_what_it_is_for(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    from importlib.metadata import version
+
+    from zenav.cli import build_parser
+
+    with pytest.raises(SystemExit) as exit_:
+        zenav_main(["--version"])
+    assert exit_.value.code == 0
+    assert capsys.readouterr().out.strip() == f"zenav {version('zenav')}"
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    bench = commands.choices["bench"]
+    kinds = next(a for a in bench._actions if isinstance(a, argparse._SubParsersAction))
+    undescribed = [name for name, child in [*commands.choices.items(), *kinds.choices.items()]
+                   if not child.description]
+    assert undescribed == []

@@ -160,6 +160,10 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
 def _command(args: argparse.Namespace) -> int:
     sections = tuple(words(args.sections))
     unknown = [s for s in sections if s not in SECTIONS]
+    if not sections:
+        print(f"zenav bench perf: --sections is empty; choose from {', '.join(SECTIONS)}",
+              file=sys.stderr)
+        return 2
     if unknown:
         print(f"zenav bench perf: unknown section {', '.join(unknown)}; choose from "
               f"{', '.join(SECTIONS)}", file=sys.stderr)
