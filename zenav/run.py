@@ -85,6 +85,21 @@ def check_overrides(params: dict[str, dict[str, Any]], overrides: list[str], pla
         raise ConfigError("\n".join(problems))
 
 
+RUN_OUTPUTS = ("run.json", "run.png", "run.mcap", "params/*.yaml", "logs/*.log")
+"""What a run writes into its ``--out`` folder (patterns under it)."""
+
+
+def clear_previous_run(out_dir: Path) -> list[Path]:
+    """Remove what an earlier run left in ``out_dir`` (:data:`RUN_OUTPUTS`), so that the
+    folder never mixes two runs' record, recording, parameters and logs; other files are
+    left alone. The paths removed."""
+    removed = [path for pattern in RUN_OUTPUTS for path in sorted(out_dir.glob(pattern))
+               if path.is_file()]
+    for path in removed:
+        path.unlink()
+    return removed
+
+
 def _finite_or_none(value: float) -> float | None:
     return None if math.isinf(value) or math.isnan(value) else round(value, 6)
 
@@ -369,6 +384,7 @@ def run_scenario(
     for text in overrides or []:
         apply_override(params, text)
     check_output_dir(out_dir)  # made only now, the input known good (PathError if it cannot)
+    clear_previous_run(out_dir)
     started = time.monotonic()
     codes: dict[str, int] = {}
     heard = Heard()
