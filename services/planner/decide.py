@@ -69,6 +69,10 @@ from zenav.services.planner.recovery import STEPS, Recovery, RecoverySettings
 
 Vec = npt.NDArray[np.float64]
 
+SPEED_GAP = 0.5
+"""The longest time between two poses that the driven speed is measured over, s (five
+scans at 10 Hz)."""
+
 
 @dataclass(frozen=True)
 class Decision:
@@ -161,7 +165,9 @@ class Planner:
         self.walled = False  # the goal cut off by the wall memory (``walled_in``)
         self.walled_stamp = -math.inf
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
-        self.last_v = 0.0
+        self.last_v = 0.0  # the speed last commanded, m/s
+        self.speed_now = 0.0  # the speed the robot drove at over the last scan, m/s
+        self.last_pose: tuple[float, float, float, float] | None = None  # x, y, heading, stamp
         self.safety_heading: float | None = None  # the safety stage's last heading
         self.safety_settings = safety.Settings(
             horizon=params.safety_horizon, step=params.safety_step,
@@ -588,7 +594,7 @@ class Planner:
         speed and safety stage takes them."""
         p = self.p
         robot = safety.Robot(
-            x=pose[0], y=pose[1], heading=pose[2], speed=self.last_v,
+            x=pose[0], y=pose[1], heading=pose[2], speed=self.speed_now,
             radius=p.robot_radius, max_speed=p.max_speed, max_omega=p.max_omega,
             heading_gain=p.heading_gain, accel=p.accel, decel=p.decel)
         group = safety.Movers(
@@ -934,6 +940,7 @@ class Planner:
         dynamic = {ob.id for ob in obstacles if ob.kind == "dynamic"}
         self.top_speeds = {i: v for i, v in self.top_speeds.items()
                            if i in dynamic or (i in self.last_seen_movers and i not in live)}
+        self.speed_now = self.driven_speed(pose, stamp)
         robot = np.array(pose[:2], dtype=np.float64)
         if self.start is None:
             self.start = robot.copy()
@@ -973,6 +980,21 @@ class Planner:
                     self.hold = None
                     decision = self.recover(pose, stamp, scan) or decision
         return self._record(decision)
+
+    def driven_speed(self, pose: tuple[float, float, float], stamp: float) -> float:
+        """The robot's forward speed over the last scan, m/s, from its last two poses (at
+        least 0: the speed and safety stage models forward motion). The command is not
+        the speed: from rest the motor bridge takes two seconds to reach 1 m/s, and a
+        roll-out that starts at the speed commanded has the robot pass in front of a
+        walker it cannot outrun. Without a pose from the last ``SPEED_GAP`` s, the
+        speed last commanded."""
+        last, self.last_pose = self.last_pose, (pose[0], pose[1], pose[2], stamp)
+        if last is None or not 0.0 < stamp - last[3] <= SPEED_GAP:
+            return self.last_v
+        x0, y0, h0, t0 = last
+        mid = h0 + wrap_angle(pose[2] - h0) / 2
+        along = (pose[0] - x0) * math.cos(mid) + (pose[1] - y0) * math.sin(mid)
+        return max(along / (stamp - t0), 0.0)
 
     def _record(self, decision: Decision) -> Decision:
         self.last_v = decision.v

@@ -14,7 +14,7 @@ import pytest
 from tests.planner.scans import scan_of
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
-from zenav.services.planner.decide import Decision, Planner
+from zenav.services.planner.decide import SPEED_GAP, Decision, Planner
 from zenav.services.planner.global_path import point_at, project
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
@@ -109,6 +109,35 @@ def test_e_a_crosser_the_robot_would_meet_still_stops_or_slows_it(x: float, y: f
     d = decide(planner(**CROWD_ROBOT), [mover(1, x, y, 0.0, vy, 0.3)], (0.0,))
     assert d.scenario == "e" and d.action in {"stop", "slow"}
     assert d.speed < 1.0
+
+
+def test_the_driven_speed_comes_from_the_last_two_poses_not_the_command() -> None:
+    p = planner(**CROWD_ROBOT)
+    assert p.driven_speed((2.0, 3.0, 0.0), 0.0) == 0.0  # no pose before: the command (none)
+    p.last_v = 1.0
+    assert p.driven_speed((2.02, 3.0, 0.0), 0.1) == pytest.approx(0.2)
+    assert p.driven_speed((2.02, 3.06, math.pi / 2), 0.2) == pytest.approx(0.6 / math.sqrt(2))
+    assert p.driven_speed((2.02, 3.0, math.pi / 2), 0.3) == 0.0  # backing: no forward speed
+    assert p.driven_speed((2.5, 3.0, 0.0), 0.3 + SPEED_GAP + 0.1) == 1.0  # poses too far apart
+
+
+def test_from_rest_the_robot_does_not_try_to_outrun_a_crosser_just_ahead() -> None:
+    # 1 m/s commanded, the robot still standing 0.1 s later; a walker 1 m ahead and 0.8 m
+    # to the right crosses the robot's line at 0.5 m/s. Standing lets it pass; from rest
+    # (0.5 m/s^2) the robot can neither pass first nor turn away in time. A roll-out that
+    # started at the speed commanded would have it step aside at speed.
+    crosser = [mover(1, 3.0, 2.2, 0.0, 0.5, 0.3)]
+    outcomes = {}
+    for measured in (True, False):
+        p = planner(**CROWD_ROBOT)
+        assert p.step(POSE, [], 0.0).v == pytest.approx(1.0)
+        if not measured:
+            p.last_pose = None  # no pose before this one: the command stands in
+        outcomes[measured] = p.step(POSE, crosser, 0.1)
+    assert p.speed_now == pytest.approx(1.0)
+    d = outcomes[True]
+    assert (d.scenario, d.action, d.v) == ("e", "stop", 0.0)
+    assert outcomes[False].action == "morphin" and outcomes[False].v > 0.3
 
 
 def test_f_a_mover_coming_head_on_is_gone_round_with_morphin() -> None:
