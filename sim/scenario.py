@@ -28,7 +28,7 @@ from pydantic import (
 )
 
 from zenav.services.inputs import AliasError, BoundedLoader, safe_load, shown, yaml_problem
-from zenav.services.mission import WINDOW_CELLS
+from zenav.services.mission import WINDOW_CELLS, window_radius
 
 __all__ = [
     "LaserSpec",
@@ -364,7 +364,7 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
     if ticks > MAX_TICKS:
         problems.append((("duration",), f"at most {MAX_TICKS} simulator ticks (got "
                          f"{ticks:.0f}: duration x max(laser.rate_hz, 10))"))
-    if scenario.laser.max_range < scenario.world.cell:
+    if window_radius(scenario.world.cell, scenario.laser.max_range) < scenario.world.cell:
         problems.append((("laser", "max_range"), f"must be at least world.cell "
                          f"({scenario.world.cell:g} m): the perception window reaches "
                          f"{WINDOW_CELLS} cells but no farther than the laser, and must hold "
