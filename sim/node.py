@@ -80,7 +80,9 @@ class Service:
         else:
             self._alive.discard(service)
             if service in self.params.wait_for:
-                log.warning("service %s went away at t=%.2f", service, self.sim.t)
+                # After the run's end the stack is being stopped: a departure is expected.
+                level = logging.WARNING if self.sim.outcome is None else logging.INFO
+                log.log(level, "service %s went away at t=%.2f", service, self.sim.t)
         self._alive_changed.set()
 
     async def wait_for_stack(self) -> None:

@@ -41,3 +41,20 @@ async def test_a_service_that_never_comes_is_named_after_the_timeout() -> None:
         bus.declare_token(Keys("test").alive(service))
     with pytest.raises(StackSilentError, match=r"still waiting on planner$"):
         await asyncio.wait_for(sim.wait_for_stack(), timeout=5)
+
+
+async def test_a_service_leaving_mid_run_warns_but_one_leaving_after_the_end_does_not(
+        caplog: pytest.LogCaptureFixture) -> None:
+    bus = InMemoryBus()
+    sim = simulator(bus, timeout=1.0)
+    tokens = {service: bus.declare_token(Keys("test").alive(service)) for service in WAIT_FOR}
+    await asyncio.sleep(0)
+    caplog.set_level("INFO", logger="zenav.sim.node")
+    tokens["planner"].undeclare()
+    await asyncio.sleep(0)
+    assert [r.levelname for r in caplog.records if "went away" in r.message] == ["WARNING"]
+    caplog.clear()
+    sim.sim.outcome = "reached"  # the run is over: the stack is being stopped
+    tokens["tracking"].undeclare()
+    await asyncio.sleep(0)
+    assert [r.levelname for r in caplog.records if "went away" in r.message] == ["INFO"]
