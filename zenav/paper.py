@@ -365,7 +365,7 @@ def main(out: Path, quick: bool = False, parallel: int = 2,
     with Progress(TextColumn("[bold]zenav paper"), BarColumn(), TextColumn("{task.completed}/"
                   "{task.total} runs"), TextColumn("{task.description}"),
                   TimeElapsedColumn(), TimeRemainingColumn()) as progress:
-        task = progress.add_task("", total=len(jobs) + 2)
+        task = progress.add_task("", total=len(jobs))
         finished: list[bool] = []
 
         def done(job: Job, record: dict[str, Any]) -> None:
@@ -376,11 +376,12 @@ def main(out: Path, quick: bool = False, parallel: int = 2,
         # keep_going: a run that fails is a result of the report, not the end of it
         records = run_batch(jobs, parallel, done, keep_going=True, reuse=reuse, engine=engine,
                             verify=verify)
+        # The bar counts runs; the steps after them only name themselves.
         progress.update(task, description="figures")
         make_figures(out, jobs, records)
-        progress.update(task, advance=1, description="typing accuracy")
+        progress.update(task, description="typing accuracy")
         accuracy = accuracy_lines(quick)
-        progress.update(task, advance=1, description="report")
+        progress.update(task, description="report")
     command = f"zenav paper --out {out}" + ("" if engine == "stack" else
                                              f" --engine {engine} --verify {verify}")
     if profiles != PROFILES:
