@@ -118,12 +118,24 @@ def _main(argv: list[str] | None) -> int:
     parser = build_light_parser(argv[0]) if argv[:1] and argv[0] in LIGHT else build_parser()
     args, rest = parser.parse_known_args(argv)
     if rest and not getattr(args, "passes_rest", False):  # only `zenav service` passes them on
-        parser.error(f"unrecognized arguments: {' '.join(rest)}")
+        _chosen(parser, args).error(f"unrecognized arguments: {' '.join(rest)}")
     args.rest = rest
     if (problem := _out_problem(args)) is not None:
         print(f"zenav {args.command}: {problem}", file=sys.stderr)
         return 2
     return int(args.func(args))
+
+
+def _chosen(parser: argparse.ArgumentParser,
+            args: argparse.Namespace) -> argparse.ArgumentParser:
+    """The (sub)command parser ``args`` came through, the deepest one: its errors carry
+    the command's own name (``zenav bench crowd: ...``), as argparse's own do."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            child = action.choices.get(getattr(args, action.dest, None) or "")
+            if child is not None:
+                return _chosen(child, args)
+    return parser
 
 
 def _out_problem(args: argparse.Namespace) -> str | None:

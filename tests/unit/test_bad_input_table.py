@@ -190,6 +190,11 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      "zenav bench bound: --margin must be >= 0 (got nan)"),
     ("params of an unknown planner", lambda t: ["params", "planner", "--planner", "foo"], 2,
      f"zenav params: no planner named 'foo'; the planners are {', '.join(PLANNERS)}"),
+    ("an unknown flag of a command", lambda t: ["run", str(SCENARIO), "--out", str(t / "o"),
+                                                "--bogus"], 2,
+     "zenav run: unrecognized arguments: --bogus"),
+    ("an unknown flag of a bench", lambda t: ["bench", "crowd", "--bogus"], 2,
+     "zenav bench crowd: unrecognized arguments: --bogus"),
 ]
 
 
