@@ -214,6 +214,12 @@ kernel releases the lock when the process ends, however it ends)."""
 
 def check_lock(lock: Path) -> None:
     """ConfigError unless ``lock`` can be opened (its folder created) as a standby lock."""
+    from zenav.writable import PathError, check_output_file
+
+    try:
+        check_output_file(lock)  # a file on the way, /proc, a folder: named as such
+    except PathError as exc:
+        raise ConfigError(f"--standby-lock {exc}") from None
     try:
         lock.parent.mkdir(parents=True, exist_ok=True)
         os.close(os.open(lock, os.O_RDWR | os.O_CREAT, 0o644))

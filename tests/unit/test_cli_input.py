@@ -219,9 +219,14 @@ def test_log_levels_are_read_in_any_case() -> None:
     ("simulator", ["--set", "scenario={t}/none.yaml"],
      "zenav simulator: {t}/none.yaml: file not found"),
     ("planner", ["--standby-lock", "/proc/zenav/x/lock"],
-     "zenav planner: --standby-lock /proc/zenav/x/lock: cannot open it as a lock file "
-     "(No such file or directory)"),
-], ids=["no-scenario", "bad-scenario", "missing-scenario", "standby-lock-in-proc"])
+     "zenav planner: --standby-lock /proc/zenav/x/lock: under /proc, which is not a place "
+     "for output"),
+    ("planner", ["--standby-lock", "{t}/neg.yaml/lock"],
+     "zenav planner: --standby-lock {t}/neg.yaml/lock: {t}/neg.yaml is a file, not a folder"),
+    ("planner", ["--standby-lock", "{t}"],
+     "zenav planner: --standby-lock {t}: is a folder, not a file"),
+], ids=["no-scenario", "bad-scenario", "missing-scenario", "standby-lock-in-proc",
+        "standby-lock-under-a-file", "standby-lock-a-folder"])
 def test_a_service_refuses_its_bad_input_with_one_line_and_status_2(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str, argv: list[str],
         line: str) -> None:
