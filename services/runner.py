@@ -136,17 +136,28 @@ def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("transport")
     group.add_argument("--robot-id", default="robot0",
                        help="robot id in every key (default robot0)")
-    group.add_argument("--transport", type=Path, help="YAML file of transport settings")
-    group.add_argument("--mode", choices=["peer", "client", "router"], help="Zenoh mode")
+    group.add_argument("--transport", type=Path, metavar="FILE",
+                       help="YAML file of transport settings (a TransportConfig: mode, "
+                            "listen, connect, ...)")
+    group.add_argument("--mode", choices=["peer", "client", "router"],
+                       help="Zenoh mode (default peer; a tool given --connect joins as a "
+                            "client)")
     group.add_argument("--listen", action="append", default=[], type=endpoint,
-                       metavar="ENDPOINT")
+                       metavar="ENDPOINT",
+                       help="listen on this Zenoh endpoint, e.g. tcp/0.0.0.0:7447 "
+                            "(repeatable; default: the loopback mesh of --base-port)")
     group.add_argument("--connect", action="append", default=[], type=endpoint,
-                       metavar="ENDPOINT")
+                       metavar="ENDPOINT",
+                       help="connect to this Zenoh endpoint, e.g. a router at "
+                            "tcp/127.0.0.1:7447 (repeatable; default: the loopback mesh "
+                            "of --base-port)")
     group.add_argument(
         "--base-port",
         type=base_port,
         default=DEFAULT_BASE_PORT,
-        help="first port of the loopback mesh used when no endpoint is given",
+        help="first port of the loopback mesh used when no endpoint is given "
+             f"(default {DEFAULT_BASE_PORT}: tcp/127.0.0.1:{DEFAULT_BASE_PORT}..."
+             f"{DEFAULT_BASE_PORT + 5})",
     )
 
 

@@ -175,7 +175,8 @@ def add_command(sub: Any) -> None:
         "as nav_msgs/msg/OccupancyGrid on a third.")
     rviz.add_argument("--domain-id", type=count(0, MAX_DOMAIN_ID), default=0,
                       help=f"ROS_DOMAIN_ID, 0 to {MAX_DOMAIN_ID} (default 0)")
-    rviz.add_argument("--topic", default="/zenav/markers", help="MarkerArray topic")
+    rviz.add_argument("--topic", default="/zenav/markers",
+                      help="MarkerArray topic (default /zenav/markers)")
     rviz.add_argument("--path-topic", default="/zenav/plan",
                       help="Path topic (default /zenav/plan)")
     rviz.add_argument("--map-topic", default="/zenav/map",

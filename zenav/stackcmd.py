@@ -102,7 +102,7 @@ def add_commands(sub: Any) -> None:
     add_log_level_argument(run, "the services' log level")
     run.add_argument("--robot", choices=["native", "ros2"], default="native",
                      help="how the simulated robot talks to the stack: zenav's device keys "
-                          "(native) or ROS 2 over rmw_zenoh (/scan, /odom, /cmd_vel)")
+                          "(native, the default) or ROS 2 over rmw_zenoh (/scan, /odom, /cmd_vel)")
     run.add_argument("--record", action="store_true",
                      help="also write DIR/run.mcap: every message of the run, with Foxglove "
                           "channels (opens in Foxglove)")
@@ -116,7 +116,7 @@ def add_commands(sub: Any) -> None:
                                          "(zenav service NAME --help).")
     service.add_argument("-h", "--help", action=_ServiceHelp, nargs=0,
                          help="this help; after NAME, the service's own options")
-    service.add_argument("name", choices=SERVICE_ORDER)
+    service.add_argument("name", choices=SERVICE_ORDER, help="the service to run")
     # the arguments zenav.cli.main does not know go to the service (args.rest)
     service.set_defaults(func=_service, passes_rest=True, service_help=False)
 

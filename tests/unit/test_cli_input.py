@@ -16,7 +16,7 @@ import yaml
 
 from tests.unit.test_bad_input_table import SCENARIO, scenario_with
 from tests.unit.test_startup_imports import loaded_by
-from zenav.cli import build_light_parser
+from zenav.cli import build_light_parser, build_parser
 from zenav.cli import main as zenav_main
 from zenav.services import inputs
 from zenav.services.inputs import ALIAS_NODES, AliasError, safe_load, shown
@@ -379,3 +379,29 @@ def test_version_and_every_subcommand_says_what_it_is_for(
     undescribed = [name for name, child in [*commands.choices.items(), *kinds.choices.items()]
                    if not child.description]
     assert undescribed == []
+
+
+def _options(parser: argparse.ArgumentParser, name: str) -> list[tuple[str, argparse.Action]]:
+    found: list[tuple[str, argparse.Action]] = []
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for word, child in action.choices.items():
+                found += _options(child, f"{name} {word}")
+        elif not isinstance(action, argparse._HelpAction | argparse._VersionAction):
+            found.append((f"{name} {'/'.join(action.option_strings) or action.dest}", action))
+    return found
+
+
+def test_every_option_of_every_command_has_help_that_gives_its_default() -> None:
+    """``zenav CMD --help`` explains each option, and a value used when the option is
+    left out is written in its help (argparse does not show it by itself)."""
+    silent, undisclosed = [], []
+    for where, action in _options(build_parser(), "zenav"):
+        if not action.help:
+            silent.append(where)
+        elif (action.default not in (None, False, [], argparse.SUPPRESS)
+              and not isinstance(action, argparse._StoreTrueAction)
+              and "default" not in action.help):
+            undisclosed.append(f"{where} ({action.default!r})")
+    assert silent == [], "options without help"
+    assert undisclosed == [], "defaults not in the help"

@@ -122,7 +122,7 @@ def main(args: argparse.Namespace) -> int:
 
 def add_command(sub: Any) -> None:
     record = sub.add_parser("record", help="record every message of a robot to an MCAP file")
-    record.add_argument("file", type=Path)
+    record.add_argument("file", type=Path, help="the MCAP file to write (replaced if it exists)")
     record.add_argument("--duration", type=positive_float, help="stop after this many s")
     record.add_argument("--exclude", type=recordable_topic, action="append", default=[],
                         metavar="TOPIC",

@@ -165,7 +165,8 @@ def main(args: argparse.Namespace) -> int:
 
 def add_command(sub: Any) -> None:
     replay = sub.add_parser("replay", help="publish a recorded MCAP file again")
-    replay.add_argument("file", type=Path)
+    replay.add_argument("file", type=Path, help="the MCAP file to publish (from zenav record "
+                        "or zenav run)")
     replay.add_argument("--rate", type=positive_float, default=1.0,
                         help="speed-up over the recorded timing (default 1: as recorded)")
     replay.add_argument("--topics", default="",
@@ -174,7 +175,7 @@ def add_command(sub: Any) -> None:
                         help="publish under this robot id instead of the recorded one")
     replay.add_argument("--wait-for", default="", metavar="SERVICES",
                         help="comma-separated services whose liveliness is awaited first "
-                        f"(any of {', '.join(WAITABLE)})")
+                        f"(any of {', '.join(WAITABLE)}; default none)")
     replay.add_argument("--timeout", type=positive_float, default=30.0,
                         help="s to wait for --wait-for (default 30)")
     add_transport_arguments(replay)

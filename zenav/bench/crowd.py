@@ -347,7 +347,8 @@ def add_command(kinds: Any) -> None:
                        help="in-process runs re-made through the stack and compared tick by "
                        f"tick (default {DEFAULT_VERIFY})")
     crowd.add_argument("--out", type=argtypes.path, default=Path("out/bench-crowd"),
-                       help="directory for the cases, runs, crowd.md, crowd.png, crowd.json")
+                       help="directory for the cases, runs, crowd.md, crowd.png, crowd.json "
+                       "(default out/bench-crowd)")
     crowd.add_argument("--reuse", action="store_true",
                        help="take a run.json already under --out as that run's record "
                        "(finish an interrupted sweep; by default every run is made again)")

@@ -402,7 +402,8 @@ def add_command(kinds: Any) -> None:
                      help=f"in-process runs re-made through the stack and compared tick by "
                      f"tick (default {DEFAULT_VERIFY})")
     nav.add_argument("--out", type=argtypes.path, default=Path("out/bench-nav"),
-                     help="directory for the worlds, runs, nav.md, nav.png, nav.json")
+                     help="directory for the worlds, runs, nav.md, nav.png, nav.json "
+                     "(default out/bench-nav)")
     nav.add_argument("--fov", type=float, default=None,
                      help="every world's laser field of view, degrees (default: each "
                      "world's own, the paper's 180; 360 shows what the 180° laser "

@@ -180,17 +180,21 @@ def add_command(kinds: Any) -> None:
                             "sustained rate, memory")
     perf.add_argument("--sections", default="compute,latency,lockstep,engine,rate",
                       help="comma-separated: compute, latency (and memory), lockstep, "
-                      "engine (the in-process engine's speed), rate")
+                      "engine (the in-process engine's speed), rate (default all)")
     perf.add_argument("--scans", type=argtypes.positive_int, default=200,
-                      help="scans timed per world (compute)")
+                      help="scans timed per world (compute; default 200)")
     perf.add_argument("--obstacles", type=argtypes.ints(argtypes.non_negative_int),
-                      default="0,5,20", help="obstacles in view, comma-separated (compute)")
+                      default="0,5,20",
+                      help="obstacles in view, comma-separated (compute; default 0,5,20)")
     perf.add_argument("--latency-seconds", type=argtypes.positive_float, default=30.0,
-                      help="wall seconds of the real-time run (latency)")
+                      help="wall seconds of the real-time run (latency; default 30)")
     perf.add_argument("--rates", type=argtypes.floats(argtypes.positive_float),
                       default="10,50,100,200,300,400,600",
-                      help="laser rates tried, Hz, comma-separated (rate)")
+                      help="laser rates tried, Hz, comma-separated (rate; default "
+                      "10,50,100,200,300,400,600)")
     perf.add_argument("--rate-seconds", type=argtypes.positive_float, default=6.0,
-                      help="wall seconds measured per rate (rate)")
-    perf.add_argument("--out", type=argtypes.path, help="directory for perf.md and the runs")
+                      help="wall seconds measured per rate (rate; default 6)")
+    perf.add_argument("--out", type=argtypes.path,
+                      help="directory for perf.md and the runs (default: "
+                      "a temporary one; the report is printed either way)")
     perf.set_defaults(func=_command)

@@ -215,17 +215,19 @@ this machine keeps up with, and short of a clock that never advances)."""
 def add_command(sub: Any) -> None:
     soak = sub.add_parser("soak", help="run the stack in real time for a long time and "
                           "report memory, drops and latency")
-    soak.add_argument("--minutes", type=argtypes.positive_float, default=30.0)
+    soak.add_argument("--minutes", type=argtypes.positive_float, default=30.0,
+                      help="wall minutes of the real-time run (default 30)")
     soak.add_argument("--rate-hz", type=argtypes.positive_float_at_most(MAX_RATE_HZ),
                       default=100.0, help="laser scan rate (default 100: 10x the paper's; "
                       f"at most {MAX_RATE_HZ:g})")
     soak.add_argument("--warmup", type=argtypes.non_negative_float, default=30.0,
-                      help="s before the first sample")
+                      help="s before the first sample (default 30)")
     soak.add_argument("--window", type=argtypes.positive_float, default=60.0,
-                      help="s of latency samples at the start and at the end")
+                      help="s of latency samples at the start and at the end (default 60)")
     soak.add_argument("--max-growth", type=argtypes.non_negative_float, default=5.0,
-                      help="allowed RSS growth, %%")
-    soak.add_argument("--out", type=argtypes.path, default=Path("out/soak"))
+                      help="allowed RSS growth, %% (default 5; above it the exit status is 1)")
+    soak.add_argument("--out", type=argtypes.path, default=Path("out/soak"),
+                      help="directory for soak.json and the run (default out/soak)")
     soak.set_defaults(func=_cmd_soak)
 
 

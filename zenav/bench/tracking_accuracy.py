@@ -369,10 +369,10 @@ def format_table(rows: Sequence[Row]) -> str:
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", type=argtypes.positive_int, default=3,
-                        help="runs per mover and setting")
+                        help="runs per mover and setting (default 3)")
     parser.add_argument("--no-per-mover", action="store_true", help="skip the per-mover tables")
     parser.add_argument("--duration", type=argtypes.positive_float, default=6.0,
-                        help="seconds per run")
+                        help="seconds per run (default 6)")
     parser.add_argument("--compare-periods", metavar="T,T,...", type=_periods, default=None,
                         help="instead: the paper profile's typing accuracy against T, the "
                              "period between the frames it compares (noise 0.01 m), e.g. "
