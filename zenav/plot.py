@@ -200,11 +200,18 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
         ax.plot(*goal, marker="*", markersize=12, color="tab:green")
         ax.add_patch(Circle(goal, scenario.robot.goal_tolerance, fill=False, ls=":",
                             color="tab:green"))
+        x_lo, x_hi = ax.get_xlim()
+        y_lo, y_hi = ax.get_ylim()
+        near = LABEL_NEAR * max(x_hi - x_lo, y_hi - y_lo)
+        points = []
         for event in record["events"]:
             i = _nearest_rows(record, event["t"])
             ax.plot(xs[i], ys[i], marker="x", color="tab:red", markersize=6)
-            ax.annotate(f"{event['scenario']}:{event['action']}", (xs[i], ys[i]),
-                        textcoords="offset points", xytext=(4, 4), fontsize=7, color="tab:red")
+            points.append((float(xs[i]), float(ys[i]),
+                           f"{event['scenario']}:{event['action']}"))
+        for x, y, text in label_groups(points, near):
+            ax.annotate(text, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                        color="tab:red", va="bottom")
         clearance = record.get("min_clearance")
         clearance_text = ("-" if clearance is None or math.isinf(clearance)
                           else f"{clearance:.2f} m")
@@ -212,6 +219,33 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
                      f"path {record['path_length']:.2f} m, min clearance {clearance_text}",
                      fontsize=9)
         _finish(fig, ax, path, "upper left")
+
+
+LABEL_NEAR = 0.04
+"""Events closer than this fraction of the plot's larger side share one label."""
+LABEL_LINES = 4
+"""Lines in a shared label before the rest are counted ("+3 more")."""
+
+
+def label_groups(points: Sequence[tuple[float, float, str]],
+                 near: float) -> list[tuple[float, float, str]]:
+    """Event labels that would overprint each other merged: each event joins the first
+    earlier group whose anchor lies within ``near`` of it (the anchor is the group's first
+    event), and a group's label lists its events in time order, one per line."""
+    groups: list[tuple[float, float, list[str]]] = []
+    for x, y, text in points:
+        for gx, gy, texts in groups:
+            if math.hypot(x - gx, y - gy) < near:
+                texts.append(text)
+                break
+        else:
+            groups.append((x, y, [text]))
+    labels = []
+    for gx, gy, texts in groups:
+        shown = texts if len(texts) <= LABEL_LINES else [
+            *texts[:LABEL_LINES - 1], f"+{len(texts) - LABEL_LINES + 1} more"]
+        labels.append((gx, gy, "\n".join(shown)))
+    return labels
 
 
 # --- zenav paper --------------------------------------------------------------------------

@@ -15,7 +15,14 @@ import pytest
 from matplotlib.colors import to_rgb
 
 import zenav.plot
-from zenav.plot import EARLIER_PATH_COLOUR, MAP_FREE_COLOUR, MAP_OCCUPIED_COLOUR, plot_run
+from zenav.plot import (
+    EARLIER_PATH_COLOUR,
+    LABEL_LINES,
+    MAP_FREE_COLOUR,
+    MAP_OCCUPIED_COLOUR,
+    label_groups,
+    plot_run,
+)
 from zenav.run import sigint_held
 from zenav.schemas.messages import GlobalPath, OccupancyMap
 from zenav.sim.scenario import load_scenario
@@ -144,3 +151,16 @@ def test_ctrl_c_while_the_picture_is_drawn_lets_it_finish_then_stops(tmp_path: P
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     finally:
         signal.signal(signal.SIGINT, inherited)
+
+
+def test_event_labels_at_one_place_share_one_label_in_time_order() -> None:
+    points = [(2.0, 3.0, "a:keep"), (2.2, 3.0, "b:morphin"), (5.0, 2.0, "a:resume"),
+              (2.1, 3.1, "h:slow")]
+    assert label_groups(points, near=0.4) == [(2.0, 3.0, "a:keep\nb:morphin\nh:slow"),
+                                              (5.0, 2.0, "a:resume")]
+
+
+def test_a_crowded_label_counts_what_it_leaves_out() -> None:
+    points = [(0.0, 0.0, f"e:stop{k}") for k in range(LABEL_LINES + 3)]
+    [(_, _, text)] = label_groups(points, near=0.1)
+    assert text.splitlines() == [*(f"e:stop{k}" for k in range(LABEL_LINES - 1)), "+4 more"]
