@@ -906,7 +906,6 @@ class Planner:
         else:
             letter = "a"
 
-
         self.asked = speed
         tx, ty = float(target[0]), float(target[1])
         v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,
