@@ -424,8 +424,13 @@ def load_scenario(path: str | Path) -> Scenario:
         text = Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ScenarioError(f"{source}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f"{source}: cannot read file ({exc})") from None
+    except IsADirectoryError:
+        raise ScenarioError(f"{source}: is a folder, not a scenario file") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(f"{source}: not a text file ({exc.reason} at byte "
+                            f"{exc.start})") from None
+    except OSError as exc:
+        raise ScenarioError(f"{source}: cannot read file ({exc.strerror or exc})") from None
     try:
         data = safe_load(text, _Loader)
     except AliasError as exc:

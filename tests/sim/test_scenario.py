@@ -313,6 +313,13 @@ def test_missing_file_is_named(tmp_path: Path) -> None:
     assert load_error(tmp_path / "gone.yaml") == f"{tmp_path / 'gone.yaml'}: file not found"
 
 
+def test_a_folder_or_a_binary_file_is_named_as_such(tmp_path: Path) -> None:
+    assert load_error(tmp_path) == f"{tmp_path}: is a folder, not a scenario file"
+    binary = tmp_path / "bin.yaml"
+    binary.write_bytes(b"name: x\n\xff\xfe\x00")
+    assert load_error(binary) == f"{binary}: not a text file (invalid start byte at byte 8)"
+
+
 @pytest.mark.parametrize(
     ("text", "expected"),
     [("", "bad.yaml: file is empty"), ("- 1\n- 2\n", "bad.yaml: the top level must be a mapping")],
