@@ -44,11 +44,15 @@ class ConfigError(ValueError):
     """A parameter or configuration file that cannot be used; the text says why."""
 
 
-def read_yaml(path: Path) -> dict[str, Any]:
+def read_yaml(path: Path, mapping: str = "parameter names to values") -> dict[str, Any]:
+    """A YAML file whose top level is a mapping (of ``mapping``, as the error says); an
+    empty file is an empty mapping. ConfigError naming the file and the problem."""
     try:
         text = path.read_text()
     except OSError as exc:
-        raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
+        raise ConfigError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"{path}: not a text file") from None
     try:
         data = safe_load(text)
     except AliasError as exc:
@@ -58,8 +62,19 @@ def read_yaml(path: Path) -> dict[str, Any]:
     if data is None:
         return {}
     if not isinstance(data, dict):
-        raise ConfigError(f"{path}: expected a mapping of parameter names to values")
+        raise ConfigError(f"{path}: expected a mapping of {mapping}")
     return data
+
+
+def read_transport(path: Path) -> TransportConfig:
+    """A transport file (``--transport``); ConfigError with one line per problem, each
+    naming the file (and the field, when one is wrong)."""
+    data = read_yaml(path, f"transport settings ({', '.join(TransportConfig.model_fields)})")
+    try:
+        return TransportConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError("\n".join(format_error(str(path), error)
+                                    for error in exc.errors(include_url=False))) from None
 
 
 def parse_assignment(text: str) -> tuple[list[str], Any]:
@@ -118,8 +133,10 @@ def _non_finite_leaves(value: object, loc: tuple[str | int, ...]
 
 def format_error(source: str, error: ErrorDetails) -> str:
     where = ".".join(str(p) for p in error["loc"]) or "(top level)"
-    got = f" (got {shown(error['input'])})" if error["type"] != "missing" else ""
-    message = error["msg"]
+    # A check of our own (value_error) quotes the value itself where it helps.
+    got = f" (got {shown(error['input'])})" if error["type"] not in ("missing",
+                                                                     "value_error") else ""
+    message = error["msg"].removeprefix("Value error, ")
     if error["type"] not in ("missing", "extra_forbidden") and non_finite(error["input"]):
         message = FINITE  # nan is not "not greater than 0": it is no number at all
     return f"{source}: {where}: {message}{got}"

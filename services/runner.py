@@ -33,7 +33,7 @@ from zenav.services.config import (
     ConfigError,
     load_params,
     loopback_mesh,
-    read_yaml,
+    read_transport,
 )
 from zenav.services.inputs import OneLineParser
 from zenav.services.transport import Bus, TransportConfig, ZenohBus, check_endpoint
@@ -197,10 +197,7 @@ def add_log_level_argument(parser: argparse.ArgumentParser, what: str = "log lev
 
 def transport_from_args(args: argparse.Namespace, service: str | None) -> TransportConfig:
     if args.transport is not None:
-        try:
-            config = TransportConfig.model_validate(read_yaml(args.transport))
-        except ValueError as exc:
-            raise ConfigError(f"{args.transport}: {exc}") from None
+        config = read_transport(args.transport)
     elif args.listen or args.connect:
         config = TransportConfig(listen=args.listen, connect=args.connect)
     else:
@@ -225,7 +222,7 @@ kernel releases the lock when the process ends, however it ends)."""
 
 def check_lock(lock: Path) -> None:
     """ConfigError unless ``lock`` can be opened (its folder created) as a standby lock."""
-    from zenav.writable import PathError, check_output_file
+    from zenav.services.writable import PathError, check_output_file
 
     try:
         check_output_file(lock)  # a file on the way, /proc, a folder: named as such

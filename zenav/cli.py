@@ -145,7 +145,7 @@ def _out_problem(args: argparse.Namespace) -> str | None:
     is known good (a refused scenario leaves no empty folder behind)."""
     from pathlib import Path
 
-    from zenav.writable import PathError, check_output_dir
+    from zenav.services.writable import PathError, check_output_dir
 
     out = getattr(args, "out", None)
     if not isinstance(out, Path):

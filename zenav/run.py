@@ -39,8 +39,8 @@ from zenav.services.profiles import DEFAULT_PROFILE, apply_profile
 from zenav.services.ros2.params import ROBOT_FACES, with_ros2_robot
 from zenav.services.runner import PLANNERS, service_params
 from zenav.services.transport import Latest, Subscription, ZenohBus
+from zenav.services.writable import check_output_dir
 from zenav.sim.scenario import load_scenario
-from zenav.writable import check_output_dir
 
 
 class RunError(RuntimeError):

@@ -17,8 +17,8 @@ from zenav.services.runner import add_log_level_argument
 def _run(args: argparse.Namespace) -> int:
     from zenav.run import RunError, run_scenario
     from zenav.services.config import ConfigError
+    from zenav.services.writable import PathError
     from zenav.sim.scenario import ScenarioError
-    from zenav.writable import PathError
 
     try:  # the folder is made once the input is known good (zenav.cli checked it could be)
         record = run_scenario(args.scenario, args.out, planner=args.planner,
@@ -66,7 +66,7 @@ def _service(args: argparse.Namespace) -> int:
 
 def _schemas(args: argparse.Namespace) -> int:
     from zenav.schemas.messages import ALL_MESSAGES
-    from zenav.writable import PathError, check_output_dir
+    from zenav.services.writable import PathError, check_output_dir
 
     schemas = {m.TYPE: m.model_json_schema(mode="serialization") for m in ALL_MESSAGES}
     if args.out is None:  # no folder given: one JSON document on stdout, nothing written

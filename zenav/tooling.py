@@ -17,13 +17,10 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Coroutine
-from pathlib import Path
 from typing import Any, TypeVar
 
-from pydantic import ValidationError
-
 from zenav.argtypes import positive_float
-from zenav.services.config import ConfigError
+from zenav.services.config import ConfigError, read_transport
 from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
@@ -73,57 +70,6 @@ def tool_transport(args: argparse.Namespace) -> TransportConfig:
     else:
         config = with_client_defaults(transport_from_args(args, None))
     return with_connect_timeout(config, getattr(args, "connect_timeout", CONNECT_TIMEOUT))
-
-
-def read_transport(path: Path) -> TransportConfig:
-    """A transport file; ConfigError with one line per problem, each naming the file (and
-    the field, when one is wrong)."""
-    import yaml
-
-    from zenav.services.inputs import AliasError, safe_load
-
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError:
-        raise ConfigError(f"{path}: not a text file") from None
-    try:
-        data = safe_load(text)  # the bounded loader every input file goes through
-    except AliasError as exc:
-        raise ConfigError(f"{path}: {exc}") from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({yaml_problem(exc)})") from None
-    if data is None:
-        data = {}
-    if not isinstance(data, dict):
-        raise ConfigError(f"{path}: expected a mapping of transport settings "
-                          f"({', '.join(TransportConfig.model_fields)})")
-    try:
-        return TransportConfig.model_validate(data)
-    except ValidationError as exc:
-        raise ConfigError("\n".join(validation_lines(str(path), exc))) from None
-
-
-def yaml_problem(exc: Exception) -> str:
-    """PyYAML's error in one line: where, and what is wrong there."""
-    import yaml
-
-    if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
-        mark = exc.problem_mark
-        return f"line {mark.line + 1}, column {mark.column + 1}: {exc.problem}"
-    return " ".join(str(exc).split())
-
-
-def validation_lines(source: str, exc: ValidationError) -> list[str]:
-    """One line per problem of a pydantic error: the source, the field, what is wrong."""
-    lines = []
-    for error in exc.errors(include_url=False):
-        where = ".".join(str(part) for part in error["loc"]) or "(top level)"
-        message = error["msg"].removeprefix("Value error, ")
-        got = "" if error["type"] in ("missing", "value_error") else f" (got {error['input']!r})"
-        lines.append(f"{source}: {where}: {message}{got}")
-    return lines
 
 
 def with_connect_timeout(config: TransportConfig, timeout: float) -> TransportConfig:

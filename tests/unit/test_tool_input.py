@@ -21,7 +21,7 @@ import pytest
 from tests.unit.clirun import zenav
 from tests.unit.test_bad_input_table import a_bag
 from zenav import argtypes, tooling
-from zenav.services.config import ConfigError
+from zenav.services.config import ConfigError, read_transport
 
 REPO = Path(__file__).resolve().parents[2]
 NOBODY = "tcp/127.0.0.1:9"
@@ -35,7 +35,7 @@ def test_a_transport_file_problem_is_one_line_each_naming_file_and_field(
     path = tmp_path / "t.yaml"
     path.write_text("mode: bogus\nlisten: 5\nconnect: [garbage]\nfoo: 1\n")
     with pytest.raises(ConfigError) as caught:
-        tooling.read_transport(path)
+        read_transport(path)
     assert str(caught.value).splitlines() == [
         f"{path}: mode: Input should be 'peer', 'client' or 'router' (got 'bogus')",
         f"{path}: listen: Input should be a valid list (got 5)",
@@ -47,25 +47,28 @@ def test_a_transport_file_problem_is_one_line_each_naming_file_and_field(
 
 @pytest.mark.parametrize(("text", "problem"), [
     (None, "cannot read (No such file or directory)"),
-    ("listen: [a\nmode: x: y\n", "not valid YAML (line 2, column 5: expected ',' or ']', "
-     "but got ':')"),
+    ("listen: [a\nmode: x: y\n", "not valid YAML (expected ',' or ']', but got ':' (line 2, "
+     "column 5))"),
+    (b"mode: \xff\xfe", "not a text file"),
     ("- a\n- b\n", "expected a mapping of transport settings (mode, listen, connect, "
      "multicast_scouting, lease_ms, extra)"),
 ])
-def test_an_unreadable_transport_file_is_one_line(tmp_path: Path, text: str | None,
+def test_an_unreadable_transport_file_is_one_line(tmp_path: Path, text: str | bytes | None,
                                                   problem: str) -> None:
     path = tmp_path / "t.yaml"
-    if text is not None:
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    elif text is not None:
         path.write_text(text)
     with pytest.raises(ConfigError) as caught:
-        tooling.read_transport(path)
+        read_transport(path)
     assert str(caught.value) == f"{path}: {problem}"
 
 
 def test_a_good_transport_file_is_read_with_the_mode_override(tmp_path: Path) -> None:
     path = tmp_path / "t.yaml"
     path.write_text("mode: client\nconnect: [tcp/127.0.0.1:7447]\n")
-    assert tooling.read_transport(path).connect == ["tcp/127.0.0.1:7447"]
+    assert read_transport(path).connect == ["tcp/127.0.0.1:7447"]
 
 
 # --- the commands' bad input: one line, status 2 --------------------------------------

@@ -13,6 +13,7 @@ from typing import Any
 from zenav.argtypes import positive_float
 from zenav.bag.mcapfile import BagWriter
 from zenav.services.runner import add_transport_arguments
+from zenav.services.writable import PathError, check_output_file
 from zenav.tooling import (
     CONNECT_TIMEOUT,
     ConnectError,
@@ -24,7 +25,6 @@ from zenav.tooling import (
     tool_setup,
     wait_for_event,
 )
-from zenav.writable import PathError, check_output_file
 
 
 def recordable_topic(topic: str) -> str:

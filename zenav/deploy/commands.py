@@ -18,7 +18,7 @@ from zenav.deploy.model import DEFAULT_CONFIG, Deployment, load_deployment
 from zenav.deploy.rpc import Supervisor, unclean_stops
 from zenav.deploy.wait import check_started, expected_alive, wait_alive, wait_running
 from zenav.services.config import ConfigError
-from zenav.writable import PathError, check_output_dir
+from zenav.services.writable import PathError, check_output_dir
 
 DEFAULT_NAME = "stack"
 """The name of the default deployment (deploy/stack.yaml): ``zenav ctl`` and ``zenav down``

@@ -19,7 +19,7 @@ from typing import Any
 
 import zenoh
 
-from zenav.services.config import ConfigError
+from zenav.services.config import ConfigError, read_transport
 from zenav.services.runner import (
     add_log_level_argument,
     add_standby_argument,
@@ -40,8 +40,6 @@ def router_transport(args: argparse.Namespace) -> TransportConfig:
     """The router's transport from its options; ConfigError with one line per problem in
     a transport file (``--listen`` and ``--connect`` are checked as they are parsed)."""
     if args.transport is not None:
-        from zenav.tooling import read_transport  # one line per problem, naming the field
-
         config = read_transport(args.transport)
     elif not args.listen and not args.connect:
         config = TransportConfig(mode="router", listen=[DEFAULT_LISTEN])
