@@ -176,6 +176,7 @@ class Planner:
             fan_step=math.radians(params.safety_fan_deg), speeds=params.safety_speeds,
             turn_cost=params.safety_turn_cost)
         self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
+        self.top_stamp: float | None = None  # the stamp top_speeds were last updated at
         # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).
         self.last_seen_movers: dict[int, tuple[Obstacle, float]] = {}
         self.unseen: list[tuple[Obstacle, float]] = []  # (predicted to now, age s)
@@ -932,9 +933,12 @@ class Planner:
         live = {ob.id for ob in obstacles}
         self.first_seen = {i: t for i, t in self.first_seen.items() if i in live}
         self.sides = {i: side for i, side in self.sides.items() if i in live}
-        self.top_speeds.update({ob.id: max(self.top_speeds.get(ob.id, 0.0),
-                                           math.hypot(*ob.velocity))
-                                for ob in obstacles if ob.kind == "dynamic"})
+        self.top_speeds.update(safety.faded_top_speeds(
+            self.top_speeds, {ob.id: math.hypot(*ob.velocity) for ob in obstacles
+                              if ob.kind == "dynamic"},
+            stamp - (self.top_stamp if self.top_stamp is not None else stamp),
+            p.top_speed_fade))
+        self.top_stamp = stamp
         self.unseen = self.remember_movers(obstacles, stamp, scan, pose[:2])
         dynamic = {ob.id for ob in obstacles if ob.kind == "dynamic"}
         self.top_speeds = {i: v for i, v in self.top_speeds.items()

@@ -104,6 +104,12 @@ class Params(MissionParams, StopZoneParams):
         0.2, ge=0, description="clearance added to a mover's predicted position per m it "
         "covers (tracked velocities are estimates; walkers turn)"
     )
+    top_speed_fade: float = Field(
+        2.0, ge=0, description="a mover's top speed (how fast its predicted clearance grows) "
+        "fades by a factor e every this many s while it stands (under a quarter of it), so "
+        "a walker standing at its goal stops being treated as one about to set off at full "
+        "speed, s; 0: never"
+    )
     safety_comfort: float = Field(
         0.6, ge=0, description="a pass within this much beyond the clearance still costs, m"
     )

@@ -15,7 +15,8 @@ command as the robot would actually drive it:
 2. **Predict** each mover (a track typed dynamic) at constant velocity, its clearance
    growing by ``growth`` times the distance it could cover at the top speed it has
    been seen at, since tracked velocities are estimates and walkers turn and speed up
-   (0.2: a heading off by about 11 degrees).
+   (0.2: a heading off by about 11 degrees). The top speed fades while the mover
+   stands (``faded_top_speeds``): one standing for good stops growing.
 3. **Score** each roll-out: the cost of contact with a mover, discounted by how far ahead
    it is (``1 / (1 + t / tau)``), plus the way still to go from where it ends to a point
    on the global path the top speed could reach in the horizon, plus a small cost of
@@ -105,6 +106,29 @@ class Choice:
     kept: bool  # the local layer's own command was safe and is kept
     contact: float  # s to the first contact of the chosen roll-out (inf: none)
     mover: int | None  # index in Movers of the mover that made the change, if any
+
+
+STANDING_FRACTION = 0.25
+"""A mover going at under this fraction of its top speed counts as standing: its top
+speed fades (``faded_top_speeds``). A walker slowed to half its pace by others is not."""
+
+
+def faded_top_speeds(top: dict[int, float], now: dict[int, float], dt: float,
+                     fade: float) -> dict[int, float]:
+    """The top speed of each mover in ``now`` (track id -> speed now, m/s): the larger of
+    its speed now and its top speed before (``top``; 0 when new), which fades by
+    ``exp(-dt / fade)`` over the ``dt`` s since while the mover stands (under
+    ``STANDING_FRACTION`` of it; ``fade`` 0: never). A walker held up by others keeps
+    its top speed, for it sets off again at the pace it had; one that has stood for a
+    few ``fade`` s (at its goal, in a queue) is judged on what it does now. Movers not
+    in ``now`` are not in the answer."""
+    keep = math.exp(-max(dt, 0.0) / fade) if fade > 0 else 1.0
+    faded = {}
+    for i, speed in now.items():
+        before = top.get(i, 0.0)
+        standing = speed < STANDING_FRACTION * before
+        faded[i] = max(before * keep if standing else before, speed)
+    return faded
 
 
 def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, Vec]:

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+import pytest
 
 from zenav.services.planner import safety
 from zenav.services.planner.decide import Planner
@@ -159,3 +160,15 @@ def test_planner_cycle_does_not_wait_for_a_crosser_with_a_walker_behind() -> Non
     assert (waits.action, waits.speed) == ("stop", 0.0) and waits.scenario == "e"
     assert steps_aside.action == "morphin" and steps_aside.speed > 0.0
     assert abs(steps_aside.target[1]) > 0.5  # off the line the walker comes along
+
+
+def test_a_top_speed_fades_while_the_mover_stands_and_comes_back_at_once() -> None:
+    top = {1: 1.0, 2: 1.0, 4: 1.0}
+    faded = safety.faded_top_speeds(top, {1: 0.0, 2: 1.2, 3: 0.5, 4: 0.5}, dt=2.0, fade=2.0)
+    assert faded[1] == pytest.approx(math.exp(-1.0))  # stood for one fade time
+    assert faded[2] == 1.2  # faster than ever: the new top
+    assert faded[3] == 0.5  # new: its speed now
+    assert faded[4] == 1.0  # held up to half its pace by others: may set off again
+    assert safety.faded_top_speeds(top, {1: 0.0}, dt=2.0, fade=0.0) == {1: 1.0}  # 0: never
+    again = safety.faded_top_speeds(faded, {1: 0.9}, dt=0.1, fade=2.0)
+    assert again[1] == 0.9  # walking again: its speed, not the faded top

@@ -140,6 +140,29 @@ def test_from_rest_the_robot_does_not_try_to_outrun_a_crosser_just_ahead() -> No
     assert outcomes[False].action == "morphin" and outcomes[False].v > 0.3
 
 
+@pytest.mark.parametrize("fade", [2.0, 0.0])
+def test_a_walker_that_has_stood_for_long_beside_the_goal_no_longer_keeps_the_robot_off(
+        fade: float) -> None:
+    # A walker came in at 1 m/s and has stood for 4 s 0.8 m beside the goal (a CrowdNav
+    # human at its own goal); another walks slowly in the window, so the speed and
+    # safety stage looks at both. With its top speed faded the standing walker's
+    # clearance stops growing and the robot drives for the goal, 1.5 m ahead; judged on
+    # the 1 m/s it once had, it would set off at any moment, and the robot steps aside.
+    p = planner(top_speed_fade=fade, **CROWD_ROBOT)
+    pose = (6.5, 3.0, 0.0)
+    d = None
+    for k in range(50):
+        t = 0.1 * k
+        walker = (mover(1, 7.0 + t, 3.8, 1.0, 0.0, 0.3) if k < 10
+                  else mover(1, 8.0, 3.8, 0.0, 0.0, 0.3))
+        d = p.step(pose, [walker, mover(2, 5.0, 1.5 - 0.3 * t, 0.0, -0.3, 0.3)], t)
+    assert d is not None
+    if fade > 0:
+        assert (d.action, d.v, d.omega) == ("keep", 1.0, 0.0)
+    else:
+        assert d.action == "morphin" and d.omega < 0  # turning away, off the goal
+
+
 def test_f_a_mover_coming_head_on_is_gone_round_with_morphin() -> None:
     d = decide(planner(), [mover(1, 5.0, 3.0, -0.2, 0.0)], stamps=(0.0,))
     assert (d.scenario, d.action) == ("f", "morphin")
