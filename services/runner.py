@@ -37,6 +37,7 @@ from zenav.services.config import (
 )
 from zenav.services.inputs import OneLineParser
 from zenav.services.transport import Bus, TransportConfig, ZenohBus, check_endpoint
+from zenav.services.writable import PathError, check_output_file
 
 if TYPE_CHECKING:
     from zenav.schemas.keys import Keys
@@ -222,14 +223,11 @@ kernel releases the lock when the process ends, however it ends)."""
 
 def check_lock(lock: Path) -> None:
     """ConfigError unless ``lock`` can be opened (its folder created) as a standby lock."""
-    from zenav.services.writable import PathError, check_output_file
-
     try:
-        check_output_file(lock)  # a file on the way, /proc, a folder: named as such
+        check_output_file(lock)  # makes its folder; a file on the way, /proc, a folder named
     except PathError as exc:
         raise ConfigError(f"--standby-lock {exc}") from None
     try:
-        lock.parent.mkdir(parents=True, exist_ok=True)
         os.close(os.open(lock, os.O_RDWR | os.O_CREAT, 0o644))
     except OSError as exc:
         raise ConfigError(f"--standby-lock {lock}: cannot open it as a lock file "
