@@ -121,7 +121,7 @@ def _main(argv: list[str] | None) -> int:
         _chosen(parser, args).error(f"unrecognized arguments: {' '.join(rest)}")
     args.rest = rest
     if (problem := _out_problem(args)) is not None:
-        print(f"zenav {args.command}: {problem}", file=sys.stderr)
+        print(f"{_chosen(parser, args).prog}: {problem}", file=sys.stderr)
         return 2
     return int(args.func(args))
 
