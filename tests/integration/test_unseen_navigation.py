@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from zenav.sim.contact import clearance
-from zenav.sim.scenario import dump_scenario, load_scenario
+from zenav.sim.scenario import Scenario, dump_scenario, load_scenario, parse_scenario
 from zenav.sim.unseen import CLASSES, unseen_scenario
 from zenav.sim.world import World
 
@@ -32,11 +32,7 @@ def zenav_run(scenario: Path, out: Path) -> dict[str, Any]:
     return record
 
 
-@pytest.mark.parametrize("kind", CLASSES)
-def test_unseen_scene_is_reached_without_contact(kind: str, tmp_path: Path) -> None:
-    path = dump_scenario(unseen_scenario(kind, SEED), tmp_path / f"{kind}.yaml")
-    scenario = load_scenario(path)
-    record = zenav_run(path, tmp_path / "run")
+def assert_reached_without_contact(scenario: Scenario, record: dict[str, Any]) -> None:
     assert record["outcome"] == "reached", \
         f"{scenario.name}: {record['outcome']} at {record['time']}"
     last = record["trajectory"][-1]
@@ -45,3 +41,85 @@ def test_unseen_scene_is_reached_without_contact(kind: str, tmp_path: Path) -> N
     gap = min(clearance((row[1], row[2]), scenario.robot.radius, world.snapshot(row[0]))
               for row in record["trajectory"])
     assert gap > 0.0
+
+
+@pytest.mark.parametrize("kind", CLASSES)
+def test_unseen_scene_is_reached_without_contact(kind: str, tmp_path: Path) -> None:
+    path = dump_scenario(unseen_scenario(kind, SEED), tmp_path / f"{kind}.yaml")
+    scenario = load_scenario(path)
+    record = zenav_run(path, tmp_path / "run")
+    assert_reached_without_contact(scenario, record)
+
+
+TURNS = ("quarter", "half", "mirror")
+
+
+def turned(scenario: Scenario, turn: str) -> Scenario:
+    """``scenario`` turned a quarter (counter-clockwise) or half turn about its world's
+    centre, or mirrored across its middle line y = height / 2: the same scene in other
+    coordinates (boxes stay axis-aligned)."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    width, height = data["world"]["size"]
+    if turn == "quarter":
+        def point(p: list[float]) -> list[float]:
+            return [height - p[1], p[0]]
+
+        def vector(v: list[float]) -> list[float]:
+            return [-v[1], v[0]]
+        data["world"]["size"] = [height, width]
+        data["robot"]["heading_deg"] += 90.0
+    elif turn == "half":
+        def point(p: list[float]) -> list[float]:
+            return [width - p[0], height - p[1]]
+
+        def vector(v: list[float]) -> list[float]:
+            return [-v[0], -v[1]]
+        data["robot"]["heading_deg"] += 180.0
+    else:
+        def point(p: list[float]) -> list[float]:
+            return [p[0], height - p[1]]
+
+        def vector(v: list[float]) -> list[float]:
+            return [v[0], -v[1]]
+        data["robot"]["heading_deg"] *= -1.0
+    data["name"] = f"{data['name']}-{turn}"
+    robot = data["robot"]
+    robot["start"], robot["goal"] = point(robot["start"]), point(robot["goal"])
+    for obstacle in data.get("obstacles", []):
+        obstacle["center"] = point(obstacle["center"])
+        if "velocity" in obstacle:
+            obstacle["velocity"] = vector(obstacle["velocity"])
+        if "goals" in obstacle:
+            obstacle["goals"] = [point(goal) for goal in obstacle["goals"]]
+        if turn == "quarter" and "size" in obstacle:
+            obstacle["size"] = obstacle["size"][::-1]
+    return parse_scenario(data, f"<{data['name']}>")
+
+
+def test_turned_mirrors_a_point_and_turns_a_box() -> None:
+    scene = parse_scenario({
+        "name": "t", "world": {"size": [10.0, 6.0], "cell": 0.5},
+        "robot": {"start": [1.0, 2.0], "heading_deg": 30.0, "goal": [9.0, 2.0],
+                  "speed": 0.1, "radius": 0.2},
+        "obstacles": [{"shape": "box", "center": [4.0, 1.0], "size": [0.5, 2.0]},
+                      {"shape": "disc", "center": [6.0, 5.0], "radius": 0.2,
+                       "velocity": [0.1, -0.2]}]}, "<t>")
+    quarter, mirror = turned(scene, "quarter"), turned(scene, "mirror")
+    assert quarter.world.size == (6.0, 10.0)
+    assert tuple(quarter.robot.start) == (4.0, 1.0) and quarter.robot.heading_deg == 120.0
+    assert quarter.obstacles[0].size == (2.0, 0.5)
+    assert tuple(quarter.obstacles[1].velocity) == (0.2, 0.1)
+    assert tuple(mirror.robot.goal) == (9.0, 4.0) and mirror.robot.heading_deg == -30.0
+    assert tuple(mirror.obstacles[1].velocity) == (0.1, 0.2)
+
+
+@pytest.mark.parametrize("kind", CLASSES)
+def test_an_unseen_scene_in_other_coordinates_is_reached_too(kind: str, tmp_path: Path) -> None:
+    """Nothing in the planner hangs on the world's axes or sides: the same unseen scene
+    turned a quarter or a half turn, or mirrored (one of the three per class, in turn),
+    is reached without contact as well."""
+    turn = TURNS[CLASSES.index(kind) % len(TURNS)]
+    scenario = turned(unseen_scenario(kind, SEED), turn)
+    path = dump_scenario(scenario, tmp_path / f"{scenario.name}.yaml")
+    record = zenav_run(path, tmp_path / "run")
+    assert_reached_without_contact(load_scenario(path), record)
