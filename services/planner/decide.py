@@ -65,9 +65,16 @@ from zenav.services.planner.prediction import (
     path_count,
     path_points,
 )
-from zenav.services.planner.recovery import STEPS, Recovery, RecoverySettings
+from zenav.services.planner.recovery import STEPS, Recovery, RecoverySettings, Step
 
 Vec = npt.NDArray[np.float64]
+
+YIELDING: tuple[Step, ...] = ("spin", "back_up", "wait")
+"""The recovery steps that end when a walker would walk into the robot (``walked_into``):
+each keeps the robot about where it is."""
+ON_THE_MAP = 0.15
+"""m: a "walker" with a cell the map holds this near its centre is taken for part of a
+wall by ``walked_into``."""
 
 SPEED_GAP = 0.5
 """The longest time between two poses that the driven speed is measured over, s (five
@@ -959,6 +966,12 @@ class Planner:
         self.update_map(pose, obstacles, scan, stamp)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
+        if (decision is not None and decision.action in YIELDING
+                and self.walked_into(pose, obstacles)):
+            # The step would keep the robot where a walker is about to walk into it: it
+            # ends, and the local layer answers the walker (the watch starts afresh).
+            self.recovery.finish(stamp, self.to_go(robot))
+            decision = None
         if decision is None:
             decision = (self.hold_aside(pose, obstacles, stamp)
                         or self.local_layer(pose, obstacles, stamp))
@@ -983,6 +996,31 @@ class Planner:
                     self.hold = None
                     decision = self.recover(pose, stamp, scan) or decision
         return self._record(decision)
+
+    def walked_into(self, pose: tuple[float, float, float], obstacles: list[Obstacle]) -> bool:
+        """Whether a walker in the window, or one remembered out of view, would touch the
+        robot standing where it is within ``safety_horizon``: the speed and safety
+        stage's roll-out of a robot at rest, each walker at constant velocity without the
+        stage's clearance growth. A recovery step that turns the robot in place, backs
+        it up or waits ends on it. Off with the stage (``speed_check``)."""
+        p = self.p
+        if not p.speed_check:
+            return False
+        walkers = [o for o in obstacles if o.kind == "dynamic" and self._moving(o)
+                   and math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+        walkers += [o for o, _ in self.unseen]
+        if self.costmap is not None:
+            # A piece of wall sweeping through the view of a robot that turns in place is
+            # tracked as a fast mover for a scan or two; a walker's centre is never on a
+            # cell the map holds.
+            walkers = [o for o in walkers if len(self.costmap.lethal_near(
+                np.asarray(o.position, dtype=np.float64), ON_THE_MAP)) == 0]
+        if not walkers:
+            return False
+        robot, group, _, _ = self._safety_inputs(pose, np.asarray(pose[:2]), walkers, None)
+        at_rest = dataclasses.replace(robot, speed=0.0)
+        plain = dataclasses.replace(self.safety_settings, growth=0.0)
+        return not safety.keeps_clear(at_rest, (pose[2], 0.0), group, None, plain)
 
     def driven_speed(self, pose: tuple[float, float, float], stamp: float) -> float:
         """The robot's forward speed over the last scan, m/s, from its last two poses (at

@@ -278,6 +278,49 @@ def test_with_nothing_driven_behind_there_is_no_back_up_then_a_wait_stands_still
     assert t - start == pytest.approx(3.0, abs=0.15)
 
 
+@pytest.mark.parametrize("step", ["spin", "wait"])
+@pytest.mark.parametrize(("walker", "ends"), [
+    (mover(7, 3.5, 3.05, -0.3, 0.0), True),   # head-on: at the robot in about 4 s
+    (mover(7, 3.5, 4.5, 0.3, 0.0), False),    # walking away, 1.5 m to the side
+    (mover(7, 7.5, 3.0, -0.3, 0.0), False),   # head-on but 18 s off: past the horizon
+])
+def test_a_recovery_step_that_stands_the_robot_ends_when_a_walker_would_walk_into_it(
+        step: str, walker: Obstacle, ends: bool) -> None:
+    p = planner(progress_timeout=2.0, spin_deg=360.0 if step == "spin" else 10.0,
+                wait_time=30.0, backup_distance=0.0)
+    t, d = stall(p, 0.0, POSE, step)
+    t = round(t + 0.1, 6)
+    d = p.step(POSE, [walker], t)
+    if ends:
+        assert d.action != step and p.recovery.active is None
+        assert d.obstacle == walker.id  # the local layer answers the walker
+    else:
+        assert d.action == step and p.recovery.active is not None
+
+
+def test_a_mover_on_a_wall_the_map_holds_does_not_end_a_recovery_step() -> None:
+    """Turning in place, the robot sees a wall's pieces sweep past: the tracker may take
+    one for a fast mover for a scan or two. On a cell the map holds, it is not a walker."""
+    p = planner(progress_timeout=2.0, spin_deg=360.0)
+    wall = [(3.4, 1.0, 3.6, 5.0)]
+    t, d = 0.0, None
+    while d is None or d.action != "spin":
+        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
+        t = round(t + 0.1, 6)
+        assert t < 60.0
+    ghost = mover(7, 3.42, 3.05, -0.3, 0.0)  # the wall's face, "walking" at the robot
+    assert p.step(POSE, [ghost], t, scan_of(POSE, boxes=wall)).action == "spin"
+    walker = mover(8, 3.0, 3.05, -0.3, 0.0)  # a walker in front of the wall does end it
+    assert p.step(POSE, [walker], round(t + 0.1, 6), scan_of(POSE, boxes=wall)).action != "spin"
+
+
+def test_a_recovery_step_does_not_end_for_a_walker_with_the_speed_stage_off() -> None:
+    p = planner(progress_timeout=2.0, spin_deg=360.0, speed_check=False)
+    t, _ = stall(p, 0.0, POSE, "spin")
+    d = p.step(POSE, [mover(7, 3.5, 3.05, -0.3, 0.0)], round(t + 0.1, 6))
+    assert d.action == "spin"
+
+
 def test_a_goal_inside_an_obstacle_ends_in_unreachable_and_the_robot_stops() -> None:
     p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
     wall = [(8.02, 1.0, 8.5, 5.0)]  # its face runs through the goal's cell: no way there
