@@ -973,8 +973,14 @@ class Planner:
             self.recovery.finish(stamp, self.to_go(robot))
             decision = None
         if decision is None:
-            decision = (self.hold_aside(pose, obstacles, stamp)
-                        or self.local_layer(pose, obstacles, stamp))
+            decision = self.hold_aside(pose, obstacles, stamp)
+            if (decision is not None and decision.speed <= 0.0
+                    and self.walked_into(pose, obstacles)):
+                # Standing at a spot aside that the walker would still walk into (found
+                # too late for a better one): the hold ends and the local layer answers.
+                self.hold = None
+                decision = None
+            decision = decision or self.local_layer(pose, obstacles, stamp)
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(decision, pose, scan)
@@ -1002,7 +1008,8 @@ class Planner:
         robot standing where it is within ``safety_horizon``: the speed and safety
         stage's roll-out of a robot at rest, each walker at constant velocity without the
         stage's clearance growth. A recovery step that turns the robot in place, backs
-        it up or waits ends on it. Off with the stage (``speed_check``)."""
+        it up or waits ends on it, and so does a hold at a spot aside where the robot
+        stands. Off with the stage (``speed_check``)."""
         p = self.p
         if not p.speed_check:
             return False

@@ -178,6 +178,24 @@ def test_a_head_on_walker_in_a_corridor_is_given_way_and_let_by() -> None:
     assert p.hold is None and d.action != "give_way"
 
 
+def test_a_hold_whose_spot_the_walker_would_still_walk_into_ends() -> None:
+    """Standing at its spot aside, the robot learns that the walker comes along a line
+    that touches it, too late for another spot: the hold ends and the local layer
+    answers the walker, instead of standing in its way."""
+    pose = (5.0, 3.1, 0.0)
+    p = corridor_planner()
+    t = map_walls(p, pose, 2.0)
+    p.step(pose, [walker(6.8)], t, scan_of(pose, boxes=WALLS, discs=[(6.8, 3.0, 0.2)]))
+    assert p.hold is not None
+    spot = p.hold.spot
+    at_spot = (spot[0], spot[1], 0.0)
+    close = Obstacle(7, "dynamic", (spot[0] + 0.7, spot[1] - 0.1), (-0.4, 0.0), 0.2,
+                     (0, 0, 0, 0))
+    d = p.step(at_spot, [close], t + 0.1,
+               scan_of(at_spot, boxes=WALLS, discs=[(spot[0] + 0.7, spot[1] - 0.1, 0.2)]))
+    assert p.hold is None and d.action != "give_way"
+
+
 def test_in_the_open_a_head_on_walker_is_not_given_way() -> None:
     pose = (5.0, 3.1, 0.0)
     p = corridor_planner()
