@@ -224,8 +224,10 @@ _DRAWS = {"appear": _appear, "wall-gap": _wall_gap, "cup": _cup, "corridor": _co
 
 # --- turning the drawn frame -----------------------------------------------------------
 
-def _turn(point: tuple[float, float], quarter: int, width: float, height: float
-          ) -> tuple[float, float]:
+def turn_point(point: tuple[float, float], quarter: int, width: float, height: float
+               ) -> tuple[float, float]:
+    """``point`` of a ``width`` x ``height`` world turned ``quarter`` times 90 degrees
+    counter-clockwise about the world's centre (into the turned world's frame)."""
     x, y = point
     if quarter == 1:
         return height - y, x
@@ -236,7 +238,8 @@ def _turn(point: tuple[float, float], quarter: int, width: float, height: float
     return x, y
 
 
-def _turn_vector(v: tuple[float, float], quarter: int) -> tuple[float, float]:
+def turn_vector(v: tuple[float, float], quarter: int) -> tuple[float, float]:
+    """``v`` turned ``quarter`` times 90 degrees counter-clockwise."""
     x, y = v
     return [(x, y), (-y, x), (-x, -y), (y, -x)][quarter]
 
@@ -251,13 +254,13 @@ def _placed(draw: Draw, quarter: int, mirror: bool) -> tuple[list[float], dict[s
         x, y = p
         if mirror:
             y = height - y
-        return [round(c, 3) for c in _turn((x, y), quarter, width, height)]
+        return [round(c, 3) for c in turn_point((x, y), quarter, width, height)]
 
     def vector(v: list[float]) -> list[float]:
         x, y = v
         if mirror:
             y = -y
-        return [round(c, 3) + 0.0 for c in _turn_vector((x, y), quarter)]
+        return [round(c, 3) + 0.0 for c in turn_vector((x, y), quarter)]
 
     size = [width, height] if quarter % 2 == 0 else [height, width]
     s, g = point(start), point(goal)

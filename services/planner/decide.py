@@ -756,8 +756,7 @@ class Planner:
         detour when one is needed, check the speed against the movers, steer."""
         p = self.p
         robot = np.array(pose[:2], dtype=np.float64)
-        in_window = [o for o in obstacles
-                     if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+        in_window = [o for o in obstacles if self._in_window(o, pose)]
         path_target = self.path_target(robot, self._statics(in_window))
 
         if self.detour is not None:
@@ -858,7 +857,7 @@ class Planner:
                 speed, action, lead = v, act, slowest
 
         unseen = [(o, age) for o, age in self.unseen
-                  if math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+                  if self._in_window(o, pose)]
         movers = [o for o in in_window if self._moving(o)]
         # Every track typed dynamic, standing ones too: their returns are not in the map.
         # Then the movers out of view, predicted from where they were last seen.
@@ -1013,8 +1012,7 @@ class Planner:
         p = self.p
         if not p.speed_check:
             return False
-        walkers = [o for o in obstacles if o.kind == "dynamic" and self._moving(o)
-                   and math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+        walkers = [o for o in obstacles if self._moving(o) and self._in_window(o, pose)]
         walkers += [o for o, _ in self.unseen]
         if self.costmap is not None:
             # A piece of wall sweeping through the view of a robot that turns in place is
@@ -1052,6 +1050,10 @@ class Planner:
         if not self.trail or math.dist(self.trail[-1], robot) >= 0.05:
             self.trail.append((float(robot[0]), float(robot[1])))
             del self.trail[:-400]
+
+    def _in_window(self, o: Obstacle, pose: tuple[float, float, float]) -> bool:
+        """Whether some of ``o`` lies within ``window_radius`` of the robot."""
+        return math.dist(o.position, pose[:2]) - o.radius <= self.p.window_radius
 
     def _moving(self, o: Obstacle) -> bool:
         """Whether ``o`` is a mover: typed dynamic and at least ``moving_speed`` fast."""
@@ -1151,7 +1153,7 @@ class Planner:
         else:  # out of view (beside or behind the robot): where it is predicted
             hold.position, hold.at = (float(where[0]), float(where[1])), stamp
         others = [o for o in obstacles if o.id != hold.mover and self._moving(o)
-                  and math.dist(o.position, pose[:2]) - o.radius <= p.window_radius]
+                  and self._in_window(o, pose)]
         clearance = p.robot_radius + hold.radius + p.safety_margin / 2
         robot = np.array(pose[:2], dtype=np.float64)
         standing = track is not None and stamp - hold.moving > p.give_way_patience

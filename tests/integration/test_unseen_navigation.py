@@ -15,7 +15,7 @@ import pytest
 
 from zenav.sim.contact import clearance
 from zenav.sim.scenario import Scenario, dump_scenario, load_scenario, parse_scenario
-from zenav.sim.unseen import CLASSES, unseen_scenario
+from zenav.sim.unseen import CLASSES, turn_point, turn_vector, unseen_scenario
 from zenav.sim.world import World
 
 pytestmark = pytest.mark.integration
@@ -52,46 +52,38 @@ def test_unseen_scene_is_reached_without_contact(kind: str, tmp_path: Path) -> N
 
 
 TURNS = ("quarter", "half", "mirror")
+QUARTERS = {"quarter": 1, "half": 2, "mirror": 0}
 
 
 def turned(scenario: Scenario, turn: str) -> Scenario:
     """``scenario`` turned a quarter (counter-clockwise) or half turn about its world's
-    centre, or mirrored across its middle line y = height / 2: the same scene in other
-    coordinates (boxes stay axis-aligned)."""
+    centre (``sim.unseen``'s turning), or mirrored across its middle line y = height / 2:
+    the same scene in other coordinates (boxes stay axis-aligned)."""
     data = scenario.model_dump(mode="json", exclude_none=True)
     width, height = data["world"]["size"]
-    if turn == "quarter":
-        def point(p: list[float]) -> list[float]:
-            return [height - p[1], p[0]]
+    quarter, mirror = QUARTERS[turn], turn == "mirror"
 
-        def vector(v: list[float]) -> list[float]:
-            return [-v[1], v[0]]
+    def point(p: list[float]) -> list[float]:
+        x, y = p
+        return list(turn_point((x, height - y if mirror else y), quarter, width, height))
+
+    def vector(v: list[float]) -> list[float]:
+        x, y = v
+        return list(turn_vector((x, -y if mirror else y), quarter))
+
+    if quarter % 2:
         data["world"]["size"] = [height, width]
-        data["robot"]["heading_deg"] += 90.0
-    elif turn == "half":
-        def point(p: list[float]) -> list[float]:
-            return [width - p[0], height - p[1]]
-
-        def vector(v: list[float]) -> list[float]:
-            return [-v[0], -v[1]]
-        data["robot"]["heading_deg"] += 180.0
-    else:
-        def point(p: list[float]) -> list[float]:
-            return [p[0], height - p[1]]
-
-        def vector(v: list[float]) -> list[float]:
-            return [v[0], -v[1]]
-        data["robot"]["heading_deg"] *= -1.0
-    data["name"] = f"{data['name']}-{turn}"
     robot = data["robot"]
+    robot["heading_deg"] = (-1.0 if mirror else 1.0) * robot["heading_deg"] + 90.0 * quarter
     robot["start"], robot["goal"] = point(robot["start"]), point(robot["goal"])
+    data["name"] = f"{data['name']}-{turn}"
     for obstacle in data.get("obstacles", []):
         obstacle["center"] = point(obstacle["center"])
         if "velocity" in obstacle:
             obstacle["velocity"] = vector(obstacle["velocity"])
         if "goals" in obstacle:
             obstacle["goals"] = [point(goal) for goal in obstacle["goals"]]
-        if turn == "quarter" and "size" in obstacle:
+        if quarter % 2 and "size" in obstacle:
             obstacle["size"] = obstacle["size"][::-1]
     return parse_scenario(data, f"<{data['name']}>")
 
