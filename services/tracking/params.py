@@ -172,6 +172,19 @@ class TrackingParams(BaseModel):
         "cluster is partly hidden (occluded, clipped by the window or the field of view): "
         "its centre then moves with what is visible, not with the obstacle.",
     )
+    hidden_fit: bool = Field(
+        True,
+        description="(smoothed) a walker seen in part (one end of its cluster free, the "
+        "other cut off by the field of view, the window or something in front) is measured "
+        "as the disc of its last whole view that touches the free end's beam: its centre and "
+        "radius come from that disc instead of from the visible sliver.",
+    )
+    fitted_meas_std: float = Field(
+        0.08,
+        gt=0.0,
+        description="metres (smoothed): standard deviation of a position measured by "
+        "hidden_fit.",
+    )
     jump_sigmas: float = Field(
         4.0,
         gt=0.0,

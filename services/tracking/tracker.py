@@ -82,6 +82,9 @@ _PIECE_BEAMS = 3
 # Stamps are sums of scan periods: 0.3 - 0.1 need not reach 0.2 exactly, so a chain counts
 # as compare_dt old within this much, seconds.
 _STAMP_SLACK = 1e-6
+# hidden_fit: the hidden end's point may lie this far off the fitted disc, metres (the free
+# end's beam grazes the walker up to a beam step inside its true silhouette).
+_FIT_SLACK = 0.15
 
 
 class Track(NamedTuple):
@@ -168,6 +171,7 @@ class _State:
     merged_since: float | None
     last_moved: float | None = None  # stamp of the last frame the motion cue fired
     born: float = 0.0  # stamp of the first frame
+    whole_radius: float = 0.0  # radius of the last view with both ends free (0: none yet)
 
 
 @dataclass(slots=True)
@@ -181,6 +185,7 @@ class _Measurement:
     area: int
     partial: bool
     n_parts: int
+    fitted: bool = False  # measured as the disc of the last whole view (hidden_fit)
 
 
 @dataclass(slots=True)
@@ -227,6 +232,18 @@ class _Rows:
             moved_refs=([(k, ref) for k, ref in enumerate(refs.tolist()) if math.isfinite(ref)]
                         if each is not None and refs is not None else None),
         )  # fmt: skip
+
+
+def _mean_range(d: float, r: float, n: int = 8) -> float:
+    """Mean range of the beams that hit a disc of radius ``r`` whose centre is ``d`` away
+    (beams evenly spread in angle over the disc: Eq. 5's mean rho of a whole view)."""
+    half = math.asin(min(r / d, 1.0))
+    total = 0.0
+    for i in range(n):
+        a = half * (2 * i + 1 - n) / n
+        s = d * math.sin(a)
+        total += d * math.cos(a) - math.sqrt(max(r * r - s * s, 0.0))
+    return total / n
 
 
 def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
@@ -303,6 +320,12 @@ class Tracker:
         groups = self._join_pieces(owner, rows, rows.chord_centre if use_chord else rows.centre)
         meas = {ti: self._measure(cl, clusters, pose, smoothed, rows)
                 for ti, cl in groups.items()}
+        if smoothed and p.hidden_fit:
+            for ti, cl in groups.items():
+                if len(cl) == 1:
+                    fit = self._fit_hidden(self._tracks[ti], meas[ti], rows, cl[0], pose)
+                    if fit is not None:
+                        meas[ti] = fit
         hold, coast = self._merges(meas, prev_stamp, stamp)
 
         claimed = {c for cl in groups.values() for c in cl}
@@ -343,6 +366,8 @@ class Tracker:
                 t.age += 1
                 if ti not in coast:
                     self._correct(t, m)
+            if not m.partial and not m.fitted and m.n_parts == 1 and ti not in coast:
+                t.whole_radius = m.radius
             was_static = t.kind == "static"
             if clusters.moved is not None:
                 cl = members[ti]
@@ -605,6 +630,46 @@ class Tracker:
             n_parts=len(cl),
         )
 
+    def _fit_hidden(
+        self, t: _State, m: _Measurement, rows: _Rows, c: int, pose: Pose
+    ) -> _Measurement | None:
+        """A walker's partial view measured as the disc of its last whole view.
+
+        One end of the cluster is free: its beam grazes the walker's silhouette, so the
+        walker's centre lies ``whole_radius`` off that beam, square to it, on the side of
+        the hidden end. The point measured is where the Eq. 5 centre of that disc seen
+        whole would be, so the filter sees no jump between whole and partial views. None
+        when the track is no walker with a whole view, both or neither end is free, or the
+        hidden end's point does not lie on that disc.
+        """
+        if t.kind != "dynamic" or t.whole_radius <= 0.0 or not m.partial:
+            return None
+        start_free = rows.edge_start[c] == EDGE_FREE
+        if start_free == (rows.edge_end[c] == EDGE_FREE):
+            return None
+        r = t.whole_radius
+        # Beams go counter-clockwise: a free first beam has the walker on its left.
+        if start_free:
+            (tx, ty), (hx, hy), side = rows.first_point[c], rows.last_point[c], 1.0
+        else:
+            (tx, ty), (hx, hy), side = rows.last_point[c], rows.first_point[c], -1.0
+        dx, dy = tx - pose[0], ty - pose[1]
+        reach = math.hypot(dx, dy)
+        if reach <= r:
+            return None
+        ux, uy = dx / reach, dy / reach
+        cx, cy = tx - side * r * uy, ty + side * r * ux
+        if abs(math.hypot(hx - cx, hy - cy) - r) > _FIT_SLACK:
+            return None
+        d = math.hypot(cx - pose[0], cy - pose[1])
+        k = _mean_range(d, r) / d
+        return _Measurement(
+            centre=m.centre,
+            point=(pose[0] + (cx - pose[0]) * k, pose[1] + (cy - pose[1]) * k),
+            radius=max(r, m.radius), box=m.box, area=m.area, partial=False, n_parts=1,
+            fitted=True,
+        )  # fmt: skip
+
     def _reference(self, stamp: float) -> Chain:
         """The chain to compare with: the newest at least ``compare_dt`` old, else the oldest."""
         limit = stamp - self.params.compare_dt + _STAMP_SLACK
@@ -685,7 +750,7 @@ class Tracker:
     def _correct(self, t: _State, m: _Measurement) -> None:
         """Kalman update with the measured point, or a position reset on a jump."""
         p = self.params
-        r = p.partial_meas_std if m.partial else p.meas_std
+        r = p.partial_meas_std if m.partial else p.fitted_meas_std if m.fitted else p.meas_std
         r2 = r * r
         ix = m.point[0] - t.x
         iy = m.point[1] - t.y
