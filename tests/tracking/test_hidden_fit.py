@@ -10,9 +10,11 @@ scene really cuts the view and that the assertions fail without the fit.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
-from tests.tracking.test_tracker import Box, Disc, drive, nearest, still
+from tests.tracking.test_tracker import Box, Disc, World, drive, nearest, still
 from zenav.services.tracking.params import TrackingParams
+from zenav.services.tracking.tracker import Track
 
 R = 0.3  # the walker's radius, m
 SPEED = 0.5
@@ -29,51 +31,50 @@ def behind_a_post(t: float) -> tuple[list[Disc], list[Box]]:
     return [(2.0, 0.0, 0.2), (3.5, -1.5 + SPEED * t, R)], []
 
 
-def test_a_walker_leaving_the_view_keeps_its_size_and_velocity() -> None:
-    def cut_frames(fit: bool) -> list[tuple[float, float]]:
-        """(radius, velocity error) of the walker's track while the edge cuts it."""
-        out = []
-        for t, tracks in drive(leaving_the_view, still, 4.0, TrackingParams(hidden_fit=fit),
-                               noise=0.01):
-            x, y, _ = leaving_the_view(t)[0][0]
-            if not -0.25 <= x <= 0.25:
-                continue
-            tr = nearest(tracks, x, y, reach=0.8)
-            assert tr is not None and tr.visible and tr.kind == "dynamic"
-            out.append((tr.radius, math.hypot(tr.vx + SPEED, tr.vy)))
-        assert len(out) >= 8
-        return out
+def cut_view(
+    world: World, walker: int, seconds: float, cut: Callable[[float, float], bool], fit: bool
+) -> list[tuple[Track, float, float]]:
+    """(track, true x, true y) of the walker on each scan that sees it while ``cut(x, y)``
+    holds for its true centre (the view of it is cut there)."""
+    out = []
+    for t, tracks in drive(world, still, seconds, TrackingParams(hidden_fit=fit), noise=0.01):
+        x, y, _ = world(t)[0][walker]
+        if not cut(x, y):
+            continue
+        tr = nearest(tracks, x, y, reach=0.8)
+        assert tr is not None and tr.kind == "dynamic"
+        if tr.visible:
+            out.append((tr, x, y))
+    assert len(out) >= 8
+    return out
 
-    fitted = cut_frames(True)
-    assert min(r for r, _ in fitted) >= 0.25
-    assert max(e for _, e in fitted) <= 0.15
-    plain = cut_frames(False)
-    assert min(r for r, _ in plain) < 0.1  # the sliver: the scene does cut the view
-    assert max(e for _, e in plain) > 0.15
+
+def test_a_walker_leaving_the_view_keeps_its_size_and_velocity() -> None:
+    def radius_and_velocity_error(fit: bool) -> tuple[float, float]:
+        seen = cut_view(leaving_the_view, 0, 4.0, lambda x, y: -0.25 <= x <= 0.25, fit)
+        return (min(tr.radius for tr, _, _ in seen),
+                max(math.hypot(tr.vx + SPEED, tr.vy) for tr, _, _ in seen))
+
+    radius, error = radius_and_velocity_error(True)
+    assert radius >= 0.25
+    assert error <= 0.15
+    radius, error = radius_and_velocity_error(False)
+    assert radius < 0.1  # the sliver: the scene does cut the view
+    assert error > 0.15
 
 
 def test_a_walker_passing_behind_a_post_keeps_its_size_and_place() -> None:
-    def cut_frames(fit: bool) -> list[tuple[float, float]]:
-        """(radius, lag along its way) of the walker's track while it is seen in part."""
-        out = []
-        for t, tracks in drive(behind_a_post, still, 6.0, TrackingParams(hidden_fit=fit),
-                               noise=0.01):
-            x, y, _ = behind_a_post(t)[0][1]
-            if not -0.6 <= y <= 0.7:
-                continue
-            tr = nearest(tracks, x, y, reach=0.8)
-            assert tr is not None and tr.kind == "dynamic"
-            if tr.visible:
-                out.append((tr.radius, abs(tr.y - y)))
-        assert len(out) >= 8
-        return out
+    def radius_and_lag(fit: bool) -> tuple[float, float]:
+        seen = cut_view(behind_a_post, 1, 6.0, lambda x, y: -0.6 <= y <= 0.7, fit)
+        return (min(tr.radius for tr, _, _ in seen),
+                max(abs(tr.y - y) for tr, _, y in seen))
 
-    fitted = cut_frames(True)
-    assert min(r for r, _ in fitted) >= 0.25
-    assert max(lag for _, lag in fitted) <= 0.1
-    plain = cut_frames(False)
-    assert min(r for r, _ in plain) < 0.1
-    assert max(lag for _, lag in plain) > 0.1
+    radius, lag = radius_and_lag(True)
+    assert radius >= 0.25
+    assert lag <= 0.1
+    radius, lag = radius_and_lag(False)
+    assert radius < 0.1
+    assert lag > 0.1
 
 
 def test_the_fit_leaves_a_walker_seen_whole_alone() -> None:
