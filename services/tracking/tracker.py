@@ -29,10 +29,12 @@ so the robot's own motion and turning cancel out of the track positions. What re
 that the visible part of an obstacle changes with the viewpoint: slowly for a whole
 obstacle (the filter sees it as a few cm/s, below ``static_speed``), suddenly when it comes
 out of hiding or leaves the window. Partly hidden clusters get a larger measurement noise,
-and a jump of the measured point (beyond ``jump_sigmas``, or when a hidden obstacle comes
-into full view) resets the position instead of turning into velocity; when no change of
-view explains the jump, the velocity is kept only with a new track's uncertainty (the track
-may have taken another obstacle for its own).
+except a walker's with one end free (``hidden_fit``): that one is measured as the disc of
+its last whole view that the free end's beam grazes. A jump of the measured point (beyond
+``jump_sigmas``, or when a hidden obstacle comes into full view) resets the position
+instead of turning into velocity; when no change of view explains the jump, the velocity
+is kept only with a new track's uncertainty (the track may have taken another obstacle for
+its own).
 
 Everything is deterministic: no randomness, ties broken by order.
 """
@@ -108,7 +110,8 @@ class Track(NamedTuple):
         xi: coincidence with the best-matching previous obstacle (Eq. 11), [0, 1].
         varsigma: varsigma_max over the previous chain (Eq. 14), 0 if there was none.
         delta: centre distance to that previous obstacle (Eq. 13), grid cells (inf if none).
-        radius: footprint radius of the visible part, metres.
+        radius: footprint radius of the visible part, metres (of the last whole view for a
+            walker fitted by ``hidden_fit``).
         age: frames in which the track was seen.
         last_seen: stamp of the last frame that saw it, seconds.
         box: grid box (ix_min, ix_max, iy_min, iy_max) when last seen.
@@ -666,6 +669,8 @@ class Tracker:
         return _Measurement(
             centre=m.centre,
             point=(pose[0] + (cx - pose[0]) * k, pose[1] + (cy - pose[1]) * k),
+            # Not partial: the filter takes it as a whole view (no reset when the walker
+            # comes into full view again), with its own noise (fitted_meas_std).
             radius=max(r, m.radius), box=m.box, area=m.area, partial=False, n_parts=1,
             fitted=True,
         )  # fmt: skip
