@@ -1,8 +1,12 @@
 """Send malformed messages on every subscribed key of a running stack.
 
 Run as its own process (``python -m tests.integration.fuzz_inject ...``) so that its
-work does not share a GIL with the test that watches the stack. It waits until the
-simulation is under way (an odometry stamp of at least ``--after`` s), then sends
+work does not share a GIL with the test that watches the stack. It draws every payload
+first; with ``--wait-go`` it then prints ``ready`` and waits for a line on stdin, so a
+test can start the stack only once the fuzz is armed (a lockstep scenario runs several
+times faster than real time, faster than a loaded machine imports and draws). It then
+waits until the simulation is under way (an odometry stamp of at least ``--after`` s),
+then sends
 ``--per-key`` payloads on each key, paced at ``--rate`` payloads per second in all, and
 writes how many it sent per key and per kind as JSON.
 
@@ -212,6 +216,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--after", type=float, default=2.0, help="start at this sim time, s")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", required=True)
+    parser.add_argument("--wait-go", action="store_true",
+                        help="print 'ready' once armed, then wait for a line on stdin")
     args = parser.parse_args(argv)
 
     k = Keys(args.robot_id)
@@ -222,6 +228,12 @@ def main(argv: list[str] | None = None) -> int:
                  if not (kind == "beam_count" and topic is keys.SCAN)]  # covered by nan etc.
         plan += [(topic, kinds[i % len(kinds)]) for i in range(args.per_key)]
     random.Random(args.seed).shuffle(plan)
+    payloads = [generator.make(topic, kind) for topic, kind in plan]
+    if args.wait_go:
+        print("ready", flush=True)
+        if not sys.stdin.readline():
+            print("fuzz: stdin closed before the go", file=sys.stderr)
+            return 1
 
     sent: Counter[str] = Counter()
     kinds_sent: Counter[str] = Counter()
@@ -240,6 +252,8 @@ def main(argv: list[str] | None = None) -> int:
         sub = session.declare_subscriber(k.of(keys.ODOM), on_odom)
         pubs = {t.name: session.declare_publisher(  # BLOCK: delivered, never lost on the way
             k.of(t), congestion_control=zenoh.CongestionControl.BLOCK) for t in FUZZED}
+        # The watching test holds the simulation back until this token is up.
+        token = session.liveliness().declare_token(k.alive("fuzz"))
         deadline = time.monotonic() + 120
         while latest[0] < args.after:
             if time.monotonic() > deadline:
@@ -247,8 +261,9 @@ def main(argv: list[str] | None = None) -> int:
                 return 1
             time.sleep(0.01)
         started = time.monotonic()
-        for i, (topic, kind) in enumerate(plan):
-            pubs[topic.name].put(generator.make(topic, kind))
+        stamp_at_start = latest[0]
+        for i, ((topic, kind), payload) in enumerate(zip(plan, payloads, strict=True)):
+            pubs[topic.name].put(payload)
             sent[topic.name] += 1
             kinds_sent[kind] += 1
             ahead = started + (i + 1) / args.rate - time.monotonic()
@@ -257,11 +272,12 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.monotonic() - started
         stamp_at_end = latest[0]
         sub.undeclare()  # type: ignore[no-untyped-call]
+        token.undeclare()  # type: ignore[no-untyped-call]
         for pub in pubs.values():
             pub.undeclare()  # type: ignore[no-untyped-call]
     with open(args.out, "w") as f:
         json.dump({"sent": dict(sent), "kinds": dict(kinds_sent), "seconds": elapsed,
-                   "sim_started": args.after, "sim_ended": stamp_at_end}, f)
+                   "sim_started": stamp_at_start, "sim_ended": stamp_at_end}, f)
     return 0
 
 
