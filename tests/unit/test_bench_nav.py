@@ -10,7 +10,15 @@ from typing import Any
 
 import pytest
 
-from zenav.bench.nav import goal_lines, never_in_view, still_at_end, summarise, write_worlds
+from zenav.bench.nav import (
+    appeared_at_contact,
+    goal_lines,
+    never_in_view,
+    no_warning,
+    still_at_end,
+    summarise,
+    write_worlds,
+)
 from zenav.sim.scenario import Scenario, load_scenario
 
 
@@ -100,10 +108,29 @@ def test_a_hit_from_behind_by_a_walker_never_in_the_field_of_view_is_told_apart(
     assert never_in_view(walker_world((0.0, 0.0)), {**hit, "agents": {
         "1": [[t, x - 1.0, 0.0] for t, x, *_ in driving]}})
     (paper,), families = summarise([hit, record("crowd-2", "reached", driving)], ["paper"],
-                            unseen_hit=lambda r: never_in_view(walker_world((2.0, 0.0)), r))
-    assert paper.hit_unseen == ["crowd-1"] and paper.collisions == 1
-    assert ("Collisions with an obstacle never in the laser's field of view: 1 of 1 "
-            "(crowd-1).") in goal_lines([paper], families)
+                            unwarned_hit=lambda r: no_warning(walker_world((2.0, 0.0)), r))
+    assert paper.hit_unwarned == ["crowd-1"] and paper.collisions == 1
+    assert ("Collisions no scan could have warned of (never in the laser's field of view, "
+            "or appeared at the contact): 1 of 1 (crowd-1).") in goal_lines([paper], families)
+
+
+def test_a_mover_that_appears_on_the_robot_is_told_apart_from_one_seen_in_time() -> None:
+    driving = [[k / 10, k / 10, 0.0, 0.0, 1.0] for k in range(25)]  # 0-2.4 s, east
+    ahead = walker_world((0.0, 0.0), start=2.6)  # standing 0.2 m ahead of the robot at 2.4 s
+    hit = {**record("crowd-1", "collision", driving), "collided_with": 1, "time": 2.4}
+    at = ahead.model_dump(mode="json", exclude_none=True)
+    at["obstacles"][1]["appear"] = 2.4  # it appears at the contact: no scan showed it
+    assert appeared_at_contact(Scenario.model_validate(at), hit)
+    assert no_warning(Scenario.model_validate(at), hit)
+    at["obstacles"][1]["appear"] = 2.2  # two laser periods (10 Hz) before: scans showed it
+    assert not appeared_at_contact(Scenario.model_validate(at), hit)
+    # There from the start, in view ahead all along: the planner's to avoid.
+    assert not appeared_at_contact(ahead, hit)
+    assert not no_warning(ahead, hit)
+    # Not a collision: nothing to tell.
+    at["obstacles"][1]["appear"] = 2.4
+    assert not appeared_at_contact(Scenario.model_validate(at),
+                                   {**hit, "outcome": "timeout"})
 
 
 @pytest.mark.parametrize("reuse", [False, True])
