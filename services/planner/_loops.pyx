@@ -455,30 +455,37 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
              const double[:, ::1] positions, const double[:, ::1] velocities,
              const double[::1] radii, const double[::1] top_speeds, const double[::1] ages,
              double robot_radius, double margin, double growth, double comfort, double tau,
-             double[:, ::1] worst, double[::1] first_t, long[::1] who):
+             const double[::1] inside, double[:, ::1] worst, double[::1] first_t,
+             long[::1] who):
     """The passes of every roll-out (rows of ``xs``, ``ys``: positions at ``times``) by
     every mover, as ``safety.contact_costs`` defines them: into ``worst`` (n, m) the
     largest cost of a pass by each mover over the horizon, into ``first_t`` the time of
     the roll-out's first contact (inf: none) and into ``who`` its mover (the first by
-    index at that time; -1: none). (``tau``, and ``comfort`` when above 0, are never 0:
-    ``Settings`` come from the planner's parameters.)"""
+    index at that time; -1: none). ``inside[j]``: the robot's distance now to mover j
+    when its clearance holds the robot now (its clearance is capped there, and a contact
+    costs its depth alone), else inf. (``tau``, and ``comfort`` when above 0, are never
+    0: ``Settings`` come from the planner's parameters.)"""
     cdef Py_ssize_t n = xs.shape[0], m = radii.shape[0], steps = times.shape[0]
     cdef Py_ssize_t i, j, k, first_k
     cdef double px, py, gap, clearance, near, depth, cost, largest
+    cdef bint held
     for i in range(n):
         first_k = steps
         who[i] = -1
         for j in range(m):
             largest = -INFINITY
+            held = inside[j] < INFINITY
             for k in range(steps):
                 px = positions[j, 0] + velocities[j, 0] * times[k]
                 py = positions[j, 1] + velocities[j, 1] * times[k]
                 clearance = (robot_radius + radii[j] + margin / 2
                              + growth * top_speeds[j] * (ages[j] + times[k]))
+                if held and inside[j] < clearance:
+                    clearance = inside[j]
                 gap = hypot(xs[i, k] - px, ys[i, k] - py) - clearance
                 if gap < 0.0:
                     depth = min(max(-gap / clearance, 0.0), 1.0)
-                    cost = 10.0 * (1.0 + depth)
+                    cost = 10.0 * (depth if held else 1.0 + depth)
                     if k < first_k:
                         first_k = k
                         who[i] = j

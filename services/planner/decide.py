@@ -181,7 +181,7 @@ class Planner:
             margin=params.safety_margin, growth=params.safety_growth,
             comfort=params.safety_comfort, tau=params.safety_tau,
             fan_step=math.radians(params.safety_fan_deg), speeds=params.safety_speeds,
-            turn_cost=params.safety_turn_cost)
+            turn_cost=params.safety_turn_cost, from_inside=params.safety_from_inside)
         self.top_speeds: dict[int, float] = {}  # track id -> top speed seen while dynamic
         self.top_stamp: float | None = None  # the stamp top_speeds were last updated at
         # Movers last seen, for ``mover_memory``: track id -> (last seen as, stamp).

@@ -113,6 +113,11 @@ class Params(MissionParams, StopZoneParams):
     safety_comfort: float = Field(
         0.6, ge=0, description="a pass within this much beyond the clearance still costs, m"
     )
+    safety_from_inside: bool = Field(
+        True, description="a mover whose clearance already holds the robot is contact only "
+        "where a roll-out comes closer to it than now, costed by how much, and the cost of "
+        "turning from the last heading is waived meanwhile (safety.py)"
+    )
     safety_tau: float = Field(
         1.5, gt=0, description="a contact t s ahead costs 1 / (1 + t / tau) of one now, s"
     )

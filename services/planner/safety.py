@@ -97,6 +97,7 @@ class Settings:
     fan_step: float  # rad between candidate headings
     speeds: tuple[float, ...]  # fractions of the top speed tried
     turn_cost: float  # cost per rad of change from the last heading chosen
+    from_inside: bool = False  # inside a mover's clearance now: only coming closer counts
 
 
 @dataclass(frozen=True)
@@ -144,10 +145,27 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
     return xs, ys
 
 
+def holding(start: tuple[float, float], movers: Movers, robot_radius: float,
+            s: Settings) -> Vec:
+    """Per mover: the robot's distance now (at ``start``) to it, when its clearance (of
+    its age, at no time ahead) holds the robot now and ``s.from_inside`` is on; inf
+    otherwise. See ``contact_costs``."""
+    inside = np.full(len(movers), math.inf)
+    if s.from_inside and len(movers):
+        ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
+        now = np.hypot(movers.positions[:, 0] - start[0], movers.positions[:, 1] - start[1])
+        clearance = (robot_radius + movers.radii + s.margin / 2
+                     + s.growth * movers.top_speeds * ages)
+        inside = np.where(now < clearance, now, math.inf)
+    return inside
+
+
 def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,
-                  s: Settings) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
+                  s: Settings, inside: Vec | None = None,
+                  ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
     """Per roll-out: the cost of its passes by the movers, the time of its first contact
-    (inf: none) and the mover of that contact (-1: none).
+    (inf: none) and the mover of that contact (-1: none). ``inside``: ``holding``'s
+    answer for the roll-outs' common start (None: no mover holds the robot).
 
     Mover j is predicted at ``positions[j] + velocities[j] t``; the robot at step t is in
     contact with it when their centres are less than the clearance apart: robot radius
@@ -156,6 +174,13 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
     its edge, 1 on the predicted centre, at most 1); a pass within ``comfort`` beyond it
     costs 1 - gap / comfort. Each cost is weighted 1 / (1 + t / tau); a roll-out pays
     the largest weighted cost of each mover over the horizon, summed over the movers.
+
+    A mover whose clearance already holds the robot (``inside``, with
+    ``Settings.from_inside``) has that clearance capped at their distance now, and a
+    contact with it costs 10 x its depth, with no floor: only coming closer counts, by
+    how much. Without the cap every candidate touches it from its first step, the first
+    step's cost is about the same for all of them, and a robot standing while the mover
+    walks in can score as well as one that leaves.
     The loop over roll-outs, movers and steps is compiled (``_loops.contacts``)."""
     n, m = xs.shape[0], len(movers)
     if m == 0:
@@ -172,7 +197,9 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
              np.ascontiguousarray(movers.top_speeds, dtype=np.float64),
              np.zeros(m) if movers.ages is None
              else np.ascontiguousarray(movers.ages, dtype=np.float64),
-             robot_radius, s.margin, s.growth, s.comfort, s.tau, worst, first_t, who)
+             robot_radius, s.margin, s.growth, s.comfort, s.tau,
+             np.full(m, math.inf) if inside is None
+             else np.ascontiguousarray(inside, dtype=np.float64), worst, first_t, who)
     return worst.sum(axis=1), first_t, who
 
 
@@ -195,7 +222,9 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     xs, ys, cost, first_t, who = _score(robot, headings, speeds, times, movers, blocked, s)
     reach = np.hypot(xs[:, -1] - carrot[0], ys[:, -1] - carrot[1])
     total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
-    if last_heading is not None:
+    if last_heading is not None and not np.isfinite(
+            holding((robot.x, robot.y), movers, robot.radius, s)).any():
+        # (not while a mover holds the robot: leaving it may need a half turn)
         total = total + s.turn_cost * np.abs(wrap_angles(headings - last_heading))
     best = int(np.argmin(total))
     culprit = int(who[0]) if who[0] >= 0 else None
@@ -224,7 +253,8 @@ def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
     """Roll out each candidate and score its passes by the movers and the map: the
     positions (n, k), the cost, the time of the first contact and its mover."""
     xs, ys = rollout(robot, headings, speeds, times)
-    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s)
+    inside = holding((robot.x, robot.y), movers, robot.radius, s)
+    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside)
     # Inside the inflation already, the map cannot judge.
     if blocked is not None and not blocked(np.array([[robot.x]]), np.array([[robot.y]]))[0]:
         cost = cost + np.where(blocked(xs, ys), 10.0, 0.0)

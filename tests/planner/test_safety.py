@@ -3,6 +3,7 @@ cycle: roll-outs, contact times worked by hand, and the choices it makes."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -172,3 +173,48 @@ def test_a_top_speed_fades_while_the_mover_stands_and_comes_back_at_once() -> No
     assert safety.faded_top_speeds(top, {1: 0.0}, dt=2.0, fade=0.0) == {1: 1.0}  # 0: never
     again = safety.faded_top_speeds(faded, {1: 0.9}, dt=0.1, fade=2.0)
     assert again[1] == 0.9  # walking again: its speed, not the faded top
+
+
+def test_a_robot_inside_a_walkers_clearance_leaves_instead_of_standing() -> None:
+    # crowd-2601 of `zenav bench nav --seed 2600` at 10.8 s, about the robot: it stands
+    # facing south-west (its last heading west), radius 0.2 m, top speed 0.5 m/s, asked
+    # to stop; a walker 0.40 m away to its south-west (radius 0.17 m, inside the
+    # clearance of 0.42 m) walks north-east into it at 0.12 m/s. Every candidate touches
+    # it from the first step, so without the cap the stop costs about what leaving does
+    # and the turn cost from the last heading keeps it: the robot was walked into.
+    p = Params()
+    s = safety.Settings(horizon=p.safety_horizon, step=p.safety_step, margin=p.safety_margin,
+                        growth=p.safety_growth, comfort=p.safety_comfort, tau=p.safety_tau,
+                        fan_step=math.radians(p.safety_fan_deg), speeds=p.safety_speeds,
+                        turn_cost=p.safety_turn_cost)
+    standing = safety.Robot(x=0.0, y=0.0, heading=math.radians(-141.0), speed=0.0,
+                            radius=0.2, max_speed=0.5, max_omega=p.max_omega,
+                            heading_gain=p.heading_gain, accel=p.accel, decel=p.decel)
+    walker = safety.Movers(np.array([[-0.28, -0.28]]), np.array([[0.07, 0.10]]),
+                           np.array([0.17]), np.array([0.12]))
+    on = dataclasses.replace(s, from_inside=True)
+    assert np.isfinite(safety.holding((0.0, 0.0), walker, 0.2, on)).all()  # held now
+    carrot, west = np.array([-2.0, 0.0]), -3.13
+    old = safety.choose(standing, (west, 0.0), walker, carrot, None, west,
+                        dataclasses.replace(s, from_inside=False))
+    assert old.kept and old.speed == 0.0  # the stop, walked into
+    new = safety.choose(standing, (west, 0.0), walker, carrot, None, west, on)
+    assert not new.kept and new.speed > 0.0
+    # Its roll-out comes less close to the walker than standing does, and ends farther
+    # from it than the robot is now. (A unicycle turning at 1 rad/s cannot get clear in
+    # time here: in the run the robot was walked into all the same.)
+    t = times()
+    xs, ys = safety.rollout(standing, np.array([new.heading, west]),
+                            np.array([new.speed, 0.0]), t)
+    gap = np.hypot(xs - (-0.28 + 0.07 * t), ys - (-0.28 + 0.10 * t))
+    assert gap[0].min() > gap[1].min() and gap[0, -1] > math.hypot(0.28, 0.28)
+
+
+def test_outside_every_clearance_the_cap_changes_nothing() -> None:
+    # The robot clear of every walker: the same choice with the setting on and off.
+    m = movers((-3.0, 0.0, 1.0, 0.0), (1.5, -1.5, 0.0, 1.0))
+    for proposal in ((0.0, 0.0), (0.0, 1.0)):
+        off = safety.choose(robot(), proposal, m, np.array([6.0, 0.0]), None, 0.3, SETTINGS)
+        on = safety.choose(robot(), proposal, m, np.array([6.0, 0.0]), None, 0.3,
+                           dataclasses.replace(SETTINGS, from_inside=True))
+        assert off == on

@@ -4,6 +4,7 @@ operations it replaced, for one roll-out and for a whole fan of them."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -16,9 +17,10 @@ Vec = npt.NDArray[np.float64]
 
 
 def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
-                        robot_radius: float, s: safety.Settings
+                        robot_radius: float, s: safety.Settings, inside: Vec | None = None,
                         ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
-    """``contact_costs`` as numpy array operations (the code ``contacts`` replaced)."""
+    """``contact_costs`` as numpy array operations (the code ``contacts`` replaced, with
+    the cap of a clearance that holds the robot now)."""
     n = xs.shape[0]
     if len(movers) == 0:
         return np.zeros(n), np.full(n, math.inf), np.full(n, -1, dtype=np.int64)
@@ -28,12 +30,17 @@ def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
     ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
     clearance = (robot_radius + movers.radii[:, None] + s.margin / 2
                  + s.growth * movers.top_speeds[:, None] * (ages[:, None] + times))
+    held = np.zeros(len(movers), dtype=bool) if inside is None else np.isfinite(inside)
+    if inside is not None:
+        clearance = np.where(held[:, None] & (inside[:, None] < clearance),
+                             inside[:, None], clearance)
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
     touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
     near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
     depth = np.clip(-gap / clearance[None], 0.0, 1.0)
-    cost_mk = np.where(touch, 10.0 * (1.0 + depth), near) * weight  # (n, m, k)
+    cost_mk = np.where(touch, 10.0 * np.where(held[None, :, None], depth, 1.0 + depth),
+                       near) * weight  # (n, m, k)
     cost = cost_mk.max(axis=2).sum(axis=1)
     any_touch: npt.NDArray[np.bool_] = np.any(touch, axis=1)  # (n, k)
     first_k = np.where(np.any(any_touch, axis=1), np.argmax(any_touch, axis=1), -1)
@@ -68,14 +75,31 @@ def random_case(seed: int, candidates: int
     return xs, ys, times, movers, s
 
 
+@pytest.mark.parametrize("from_inside", [False, True])
 @pytest.mark.parametrize("candidates", [1, 37])
 @pytest.mark.parametrize("seed", range(40))
-def test_contacts_is_the_numpy_arithmetic(seed: int, candidates: int) -> None:
+def test_contacts_is_the_numpy_arithmetic(seed: int, candidates: int, from_inside: bool
+                                          ) -> None:
     xs, ys, times, movers, s = random_case(seed, candidates)
-    got = safety.contact_costs(xs, ys, times, movers, 0.3, s)
-    want = numpy_contact_costs(xs, ys, times, movers, 0.3, s)
+    s = dataclasses.replace(s, from_inside=from_inside)
+    inside = safety.holding((0.0, 0.0), movers, 0.3, s)  # the robot starts at the origin
+    got = safety.contact_costs(xs, ys, times, movers, 0.3, s, inside)
+    want = numpy_contact_costs(xs, ys, times, movers, 0.3, s, inside)
     for a, b in zip(got, want, strict=True):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_some_random_cases_start_inside_a_clearance() -> None:
+    """The cases above hold the robot inside some mover's clearance in a few of them (so
+    the cap is exercised), and never when ``from_inside`` is off."""
+    held = off = 0
+    for seed in range(40):
+        _, _, _, movers, s = random_case(seed, 1)
+        held += int(np.isfinite(safety.holding(
+            (0.0, 0.0), movers, 0.3, dataclasses.replace(s, from_inside=True))).any())
+        off += int(np.isfinite(safety.holding(
+            (0.0, 0.0), movers, 0.3, dataclasses.replace(s, from_inside=False))).any())
+    assert held >= 3 and off == 0
 
 
 def test_the_random_cases_have_contacts_passes_and_clear_roll_outs() -> None:
