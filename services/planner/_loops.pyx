@@ -480,7 +480,7 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
                 py = positions[j, 1] + velocities[j, 1] * times[k]
                 clearance = (robot_radius + radii[j] + margin / 2
                              + growth * top_speeds[j] * (ages[j] + times[k]))
-                if held and inside[j] < clearance:
+                if held:  # (below the clearance of every step: it grows with time)
                     clearance = inside[j]
                 gap = hypot(xs[i, k] - px, ys[i, k] - py) - clearance
                 if gap < 0.0:

@@ -213,17 +213,18 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     times = _times(s)
     # The proposal alone first: most cycles keep it, and the fan's roll-outs (the same
     # numbers for the proposal, row by row) are needed only when it is not safe.
-    if keeps_clear(robot, proposal, movers, blocked, s):
+    inside = holding((robot.x, robot.y), movers, robot.radius, s)
+    if keeps_clear(robot, proposal, movers, blocked, s, inside):
         return Choice(heading, speed, True, math.inf, None)
     fan = np.arange(-math.pi, math.pi, s.fan_step)
     headings = np.concatenate(([heading], np.repeat(heading + fan, len(s.speeds))))
     speeds = np.concatenate(([speed], np.tile(np.asarray(s.speeds) * robot.max_speed,
                                               fan.shape[0])))
-    xs, ys, cost, first_t, who = _score(robot, headings, speeds, times, movers, blocked, s)
+    xs, ys, cost, first_t, who = _score(robot, headings, speeds, times, movers, blocked, s,
+                                        inside)
     reach = np.hypot(xs[:, -1] - carrot[0], ys[:, -1] - carrot[1])
     total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
-    if last_heading is not None and not np.isfinite(
-            holding((robot.x, robot.y), movers, robot.radius, s)).any():
+    if last_heading is not None and not np.isfinite(inside).any():
         # (not while a mover holds the robot: leaving it may need a half turn)
         total = total + s.turn_cost * np.abs(wrap_angles(headings - last_heading))
     best = int(np.argmin(total))
@@ -233,11 +234,12 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
 
 
 def keeps_clear(robot: Robot, proposal: tuple[float, float], movers: Movers,
-                blocked: Blocked | None, s: Settings) -> bool:
+                blocked: Blocked | None, s: Settings, inside: Vec | None = None) -> bool:
     """Whether the roll-out of ``proposal`` (heading rad, speed m/s) touches no mover and
-    nothing the map holds within the horizon."""
+    nothing the map holds within the horizon. ``inside``: ``holding``'s answer for the
+    robot, when the caller has it."""
     _, _, cost, first_t, _ = _score(robot, np.array([proposal[0]]), np.array([proposal[1]]),
-                                    _times(s), movers, blocked, s)
+                                    _times(s), movers, blocked, s, inside)
     return bool(math.isinf(first_t[0]) and cost[0] < 10.0)
 
 
@@ -248,12 +250,14 @@ def _times(s: Settings) -> Vec:
 
 
 def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
-           blocked: Blocked | None, s: Settings
+           blocked: Blocked | None, s: Settings, inside: Vec | None = None
            ) -> tuple[Vec, Vec, Vec, Vec, npt.NDArray[np.int64]]:
     """Roll out each candidate and score its passes by the movers and the map: the
-    positions (n, k), the cost, the time of the first contact and its mover."""
+    positions (n, k), the cost, the time of the first contact and its mover. ``inside``:
+    ``holding``'s answer for the robot (found here when not given)."""
     xs, ys = rollout(robot, headings, speeds, times)
-    inside = holding((robot.x, robot.y), movers, robot.radius, s)
+    if inside is None:
+        inside = holding((robot.x, robot.y), movers, robot.radius, s)
     cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside)
     # Inside the inflation already, the map cannot judge.
     if blocked is not None and not blocked(np.array([[robot.x]]), np.array([[robot.y]]))[0]:

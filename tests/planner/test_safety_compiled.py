@@ -32,8 +32,7 @@ def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
                  + s.growth * movers.top_speeds[:, None] * (ages[:, None] + times))
     held = np.zeros(len(movers), dtype=bool) if inside is None else np.isfinite(inside)
     if inside is not None:
-        clearance = np.where(held[:, None] & (inside[:, None] < clearance),
-                             inside[:, None], clearance)
+        clearance = np.where(held[:, None], inside[:, None], clearance)
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
     touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
