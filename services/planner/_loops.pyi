@@ -41,5 +41,5 @@ def box_gaps(sx: float, sy: float, dx: float, dy: float, length: float, count: i
 def c_hypot(x: float, y: float) -> float: ...
 def contacts(xs: _F, ys: _F, times: _F, positions: _F, velocities: _F, radii: _F,
              top_speeds: _F, ages: _F, robot_radius: float, margin: float, growth: float,
-             comfort: float, tau: float, inside: _F, worst: _F, first_t: _F,
+             comfort: float, tau: float, inside: _F, ends: _I, worst: _F, first_t: _F,
              who: _I) -> None: ...

@@ -455,10 +455,11 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
              const double[:, ::1] positions, const double[:, ::1] velocities,
              const double[::1] radii, const double[::1] top_speeds, const double[::1] ages,
              double robot_radius, double margin, double growth, double comfort, double tau,
-             const double[::1] inside, double[:, ::1] worst, double[::1] first_t,
-             long[::1] who):
-    """The passes of every roll-out (rows of ``xs``, ``ys``: positions at ``times``) by
-    every mover, as ``safety.contact_costs`` defines them: into ``worst`` (n, m) the
+             const double[::1] inside, const long[::1] ends, double[:, ::1] worst,
+             double[::1] first_t, long[::1] who):
+    """The passes of every roll-out (rows of ``xs``, ``ys``: positions at ``times``; row
+    i's first ``ends[i]`` steps, at least one, are driven) by every mover, as
+    ``safety.contact_costs`` defines them: into ``worst`` (n, m) the
     largest cost of a pass by each mover over the horizon, into ``first_t`` the time of
     the roll-out's first contact (inf: none) and into ``who`` its mover (the first by
     index at that time; -1: none). ``inside[j]``: the robot's distance now to mover j
@@ -475,7 +476,7 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
         for j in range(m):
             largest = -INFINITY
             held = inside[j] < INFINITY
-            for k in range(steps):
+            for k in range(ends[i]):
                 px = positions[j, 0] + velocities[j, 0] * times[k]
                 py = positions[j, 1] + velocities[j, 1] * times[k]
                 clearance = (robot_radius + radii[j] + margin / 2

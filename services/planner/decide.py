@@ -604,7 +604,8 @@ class Planner:
         robot = safety.Robot(
             x=pose[0], y=pose[1], heading=pose[2], speed=self.speed_now,
             radius=p.robot_radius, max_speed=p.max_speed, max_omega=p.max_omega,
-            heading_gain=p.heading_gain, accel=p.accel, decel=p.decel)
+            heading_gain=p.heading_gain, accel=p.accel, decel=p.decel,
+            goal=(float(self.goal[0]), float(self.goal[1])), arrive_within=p.arrival_distance())
         group = safety.Movers(
             np.array([o.position for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
@@ -956,7 +957,7 @@ class Planner:
             self._set_path(np.vstack([self.start, self.goal]), "start")
         self._remember_trail(robot)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        if float(np.hypot(*(self.goal - robot))) <= p.goal_tolerance / 2:
+        if float(np.hypot(*(self.goal - robot))) <= p.arrival_distance():
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
         if self.recovery.unreachable:

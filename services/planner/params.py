@@ -320,6 +320,11 @@ class Params(MissionParams, StopZoneParams):
         "or not seen moving, for this long, s"
     )
 
+    def arrival_distance(self) -> float:
+        """m: the planner stops for good this close to the goal, half the tolerance the
+        run is judged by, so it stops inside it."""
+        return self.goal_tolerance / 2
+
     def effective_progress_timeout(self) -> float:
         if self.progress_timeout is not None:
             return self.progress_timeout

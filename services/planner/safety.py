@@ -31,6 +31,10 @@ command as the robot would actually drive it:
 4. A mover that has left the laser's view (``Movers.ages``: seconds since it was last
    seen) is predicted from where it was last seen, its clearance grown for the time
    since as well.
+5. A roll-out that comes within ``Robot.arrive_within`` of the goal stands there, and
+   its later steps are not checked: the planner stops for good at that distance, so
+   what lies past the goal (a walker standing at its own goal beyond it) does not hold
+   the robot short of it.
 
 The local layer's own command stands when its roll-out keeps clear of every mover
 within ``horizon``: the paper's responses are kept whenever they are safe. Otherwise the
@@ -84,6 +88,8 @@ class Robot:
     heading_gain: float
     accel: float
     decel: float
+    goal: tuple[float, float] | None = None  # a roll-out that comes within
+    arrive_within: float = 0.0  # this many m of the goal stops there (the planner does)
 
 
 @dataclass(frozen=True)
@@ -134,7 +140,9 @@ def faded_top_speeds(top: dict[int, float], now: dict[int, float], dt: float,
 
 def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, Vec]:
     """Positions (n, k) of the robot driving toward each heading at each speed, at
-    ``times`` (k,), evenly spaced from one step on."""
+    ``times`` (k,), evenly spaced from one step on. A roll-out that comes within
+    ``robot.arrive_within`` of ``robot.goal`` stays at the first point it does: the
+    planner stops there, so what lies past the goal is never driven into."""
     n, k = headings.shape[0], times.shape[0]
     xs = np.empty((n, k))
     ys = np.empty((n, k))
@@ -142,7 +150,25 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
           np.ascontiguousarray(speeds, dtype=np.float64), float(times[0]), robot.x, robot.y,
           robot.heading, robot.speed, robot.heading_gain, robot.max_omega, robot.accel,
           robot.decel, xs, ys)
+    ends = steps_driven(robot, xs, ys)
+    if int(ends.min()) < k:
+        last = np.minimum(np.arange(k)[None, :], ends[:, None] - 1)
+        xs = np.take_along_axis(xs, last, axis=1)
+        ys = np.take_along_axis(ys, last, axis=1)
     return xs, ys
+
+
+def steps_driven(robot: Robot, xs: Vec, ys: Vec) -> npt.NDArray[np.int64]:
+    """Per roll-out (rows of ``xs``, ``ys``), how many of its steps are driven: all of
+    them, or those up to the first within ``robot.arrive_within`` of ``robot.goal``,
+    where the planner stops for good; what comes after is not checked."""
+    n, k = xs.shape
+    if robot.goal is None:
+        return np.full(n, k, dtype=np.int64)
+    there = np.hypot(xs - robot.goal[0], ys - robot.goal[1]) <= robot.arrive_within
+    ends: npt.NDArray[np.int64] = np.where(there.any(axis=1), np.argmax(there, axis=1) + 1,
+                                          k).astype(np.int64)
+    return ends
 
 
 def holding(start: tuple[float, float], movers: Movers, robot_radius: float,
@@ -162,10 +188,12 @@ def holding(start: tuple[float, float], movers: Movers, robot_radius: float,
 
 def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: float,
                   s: Settings, inside: Vec | None = None,
+                  ends: npt.NDArray[np.int64] | None = None,
                   ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
     """Per roll-out: the cost of its passes by the movers, the time of its first contact
     (inf: none) and the mover of that contact (-1: none). ``inside``: ``holding``'s
-    answer for the roll-outs' common start (None: no mover holds the robot).
+    answer for the roll-outs' common start (None: no mover holds the robot). ``ends``:
+    ``steps_driven``'s answer (None: every step); later steps are not checked.
 
     Mover j is predicted at ``positions[j] + velocities[j] t``; the robot at step t is in
     contact with it when their centres are less than the clearance apart: robot radius
@@ -199,7 +227,9 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
              else np.ascontiguousarray(movers.ages, dtype=np.float64),
              robot_radius, s.margin, s.growth, s.comfort, s.tau,
              np.full(m, math.inf) if inside is None
-             else np.ascontiguousarray(inside, dtype=np.float64), worst, first_t, who)
+             else np.ascontiguousarray(inside, dtype=np.float64),
+             np.full(n, times.shape[0], dtype=np.int64) if ends is None
+             else np.ascontiguousarray(ends, dtype=np.int64), worst, first_t, who)
     return worst.sum(axis=1), first_t, who
 
 
@@ -258,7 +288,8 @@ def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
     xs, ys = rollout(robot, headings, speeds, times)
     if inside is None:
         inside = holding((robot.x, robot.y), movers, robot.radius, s)
-    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside)
+    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside,
+                                       steps_driven(robot, xs, ys))
     # Inside the inflation already, the map cannot judge.
     if blocked is not None and not blocked(np.array([[robot.x]]), np.array([[robot.y]]))[0]:
         cost = cost + np.where(blocked(xs, ys), 10.0, 0.0)

@@ -218,3 +218,38 @@ def test_outside_every_clearance_the_cap_changes_nothing() -> None:
         on = safety.choose(robot(), proposal, m, np.array([6.0, 0.0]), None, 0.3,
                            dataclasses.replace(SETTINGS, from_inside=True))
         assert off == on
+
+
+def test_a_roll_out_stops_at_the_goal() -> None:
+    """Past the point where it comes within ``arrive_within`` of the goal, a roll-out
+    stands there: the planner stops for good at that distance."""
+    near_goal = dataclasses.replace(robot(speed=1.0), goal=(1.0, 0.0), arrive_within=0.15)
+    xs, ys = safety.rollout(near_goal, np.array([0.0]), np.array([1.0]), times())
+    ends = safety.steps_driven(near_goal, xs, ys)
+    arrival = int(ends[0]) - 1
+    assert 0.85 <= xs[0, arrival] <= 1.0 and xs[0, arrival - 1] < 0.85
+    assert np.all(xs[0, arrival:] == xs[0, arrival]) and np.all(ys[0] == 0.0)
+    free = safety.rollout(robot(speed=1.0), np.array([0.0]), np.array([1.0]), times())[0]
+    assert np.array_equal(xs[0, :ends[0]], free[0, :ends[0]]) and free[0, -1] > 5.0
+
+
+def test_what_lies_past_the_goal_does_not_hold_the_robot_short_of_it() -> None:
+    """A crowd case (circle crossing, visible, case 1627) timed out 0.34 m from the goal:
+    a human standing at its own goal 0.6 m beyond the robot's was in the map, every
+    roll-out toward the goal ran on through its inflation, and the robot stood. A
+    roll-out that stops at the goal keeps the local layer's command."""
+    start = dataclasses.replace(robot(heading=math.pi), x=0.34)
+    human = np.array([-0.56, -0.25])
+
+    def blocked(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64]
+                ) -> npt.NDArray[np.bool_]:
+        return np.asarray(np.any(np.hypot(xs - human[0], ys - human[1]) < 0.55, axis=1))
+
+    carrot = np.array([-0.66, 0.0])  # the look-ahead point lies past the goal
+    nobody = movers()
+    ahead = (math.pi, 1.0)
+    assert not safety.keeps_clear(start, ahead, nobody, blocked, SETTINGS)
+    with_goal = dataclasses.replace(start, goal=(0.0, 0.0), arrive_within=0.15)
+    assert safety.keeps_clear(with_goal, ahead, nobody, blocked, SETTINGS)
+    choice = safety.choose(with_goal, ahead, nobody, carrot, blocked, math.pi, SETTINGS)
+    assert choice.kept and choice.speed == 1.0

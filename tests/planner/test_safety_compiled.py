@@ -18,10 +18,12 @@ Vec = npt.NDArray[np.float64]
 
 def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
                         robot_radius: float, s: safety.Settings, inside: Vec | None = None,
+                        ends: npt.NDArray[np.int64] | None = None,
                         ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
     """``contact_costs`` as numpy array operations (the code ``contacts`` replaced, with
-    the cap of a clearance that holds the robot now)."""
-    n = xs.shape[0]
+    the cap of a clearance that holds the robot now, and the steps past a roll-out's
+    arrival left out)."""
+    n, k = xs.shape
     if len(movers) == 0:
         return np.zeros(n), np.full(n, math.inf), np.full(n, -1, dtype=np.int64)
     px = movers.positions[:, 0, None] + movers.velocities[:, 0, None] * times  # (m, k)
@@ -35,11 +37,13 @@ def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
         clearance = np.where(held[:, None], inside[:, None], clearance)
     gap -= clearance[None]
     weight = 1.0 / (1.0 + times / s.tau)
-    touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0)
+    driven = np.arange(k)[None, :] < (np.full(n, k) if ends is None else ends)[:, None]
+    touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0) & driven[:, None, :]
     near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
     depth = np.clip(-gap / clearance[None], 0.0, 1.0)
     cost_mk = np.where(touch, 10.0 * np.where(held[None, :, None], depth, 1.0 + depth),
                        near) * weight  # (n, m, k)
+    cost_mk = np.where(driven[:, None, :], cost_mk, -np.inf)
     cost = cost_mk.max(axis=2).sum(axis=1)
     any_touch: npt.NDArray[np.bool_] = np.any(touch, axis=1)  # (n, k)
     first_k = np.where(np.any(any_touch, axis=1), np.argmax(any_touch, axis=1), -1)
@@ -50,9 +54,11 @@ def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
 
 
 def random_case(seed: int, candidates: int
-                ) -> tuple[Vec, Vec, Vec, safety.Movers, safety.Settings]:
+                ) -> tuple[Vec, Vec, Vec, safety.Movers, safety.Settings,
+                           npt.NDArray[np.int64]]:
     """Roll-outs of a random robot among random movers, with random settings (a
-    ``comfort`` of 0 in some, movers out of view for a while in others)."""
+    ``comfort`` of 0 in some, movers out of view for a while in others, a goal nearby
+    where some roll-outs stop in others), and the steps each drives."""
     rng = np.random.default_rng(seed)
     s = safety.Settings(horizon=float(rng.uniform(2.0, 6.0)), step=0.2,
                         margin=float(rng.uniform(0.0, 0.3)),
@@ -61,7 +67,10 @@ def random_case(seed: int, candidates: int
                         fan_step=math.radians(15.0), speeds=(0.0, 0.5, 1.0), turn_cost=0.3)
     robot = safety.Robot(x=0.0, y=0.0, heading=float(rng.uniform(-math.pi, math.pi)),
                          speed=float(rng.uniform(0.0, 1.0)), radius=0.3, max_speed=1.0,
-                         max_omega=1.0, heading_gain=1.5, accel=0.5, decel=1.0)
+                         max_omega=1.0, heading_gain=1.5, accel=0.5, decel=1.0,
+                         goal=None if rng.integers(0, 2) else (
+                             float(rng.uniform(-2.0, 2.0)), float(rng.uniform(-2.0, 2.0))),
+                         arrive_within=float(rng.uniform(0.15, 0.8)))
     times = s.step * np.arange(1, round(s.horizon / s.step) + 1, dtype=np.float64)
     xs, ys = safety.rollout(robot, rng.uniform(-math.pi, math.pi, candidates),
                             rng.uniform(0.0, 1.0, candidates), times)
@@ -71,7 +80,7 @@ def random_case(seed: int, candidates: int
                            rng.uniform(0.15, 0.4, m),
                            np.hypot(velocities[:, 0], velocities[:, 1]) * rng.uniform(1, 1.5, m),
                            None if rng.integers(0, 2) else rng.uniform(0.0, 2.0, m))
-    return xs, ys, times, movers, s
+    return xs, ys, times, movers, s, safety.steps_driven(robot, xs, ys)
 
 
 @pytest.mark.parametrize("from_inside", [False, True])
@@ -79,11 +88,11 @@ def random_case(seed: int, candidates: int
 @pytest.mark.parametrize("seed", range(40))
 def test_contacts_is_the_numpy_arithmetic(seed: int, candidates: int, from_inside: bool
                                           ) -> None:
-    xs, ys, times, movers, s = random_case(seed, candidates)
+    xs, ys, times, movers, s, ends = random_case(seed, candidates)
     s = dataclasses.replace(s, from_inside=from_inside)
     inside = safety.holding((0.0, 0.0), movers, 0.3, s)  # the robot starts at the origin
-    got = safety.contact_costs(xs, ys, times, movers, 0.3, s, inside)
-    want = numpy_contact_costs(xs, ys, times, movers, 0.3, s, inside)
+    got = safety.contact_costs(xs, ys, times, movers, 0.3, s, inside, ends)
+    want = numpy_contact_costs(xs, ys, times, movers, 0.3, s, inside, ends)
     for a, b in zip(got, want, strict=True):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
 
@@ -93,7 +102,7 @@ def test_some_random_cases_start_inside_a_clearance() -> None:
     the cap is exercised), and never when ``from_inside`` is off."""
     held = off = 0
     for seed in range(40):
-        _, _, _, movers, s = random_case(seed, 1)
+        _, _, _, movers, s, _ = random_case(seed, 1)
         held += int(np.isfinite(safety.holding(
             (0.0, 0.0), movers, 0.3, dataclasses.replace(s, from_inside=True))).any())
         off += int(np.isfinite(safety.holding(
@@ -106,9 +115,20 @@ def test_the_random_cases_have_contacts_passes_and_clear_roll_outs() -> None:
     10) and roll-outs clear of every mover (0), in both settings of ``comfort``."""
     seen: set[tuple[str, bool]] = set()
     for seed in range(40):
-        xs, ys, times, movers, s = random_case(seed, 37)
+        xs, ys, times, movers, s, _ = random_case(seed, 37)
         for c in numpy_contact_costs(xs, ys, times, movers, 0.3, s)[0]:
             kind = "contact" if c >= 10.0 else "near" if c > 0.0 else "clear"
             seen.add((kind, s.comfort > 0))
     assert {("contact", True), ("near", True), ("clear", True), ("contact", False),
             ("clear", False)} <= seen
+
+
+def test_some_random_roll_outs_stop_at_the_goal() -> None:
+    """Some roll-outs of the cases above reach their goal and stop there (the compiled
+    loop leaves their later steps out), some drive every step."""
+    short = whole = 0
+    for seed in range(40):
+        xs, _, _, _, _, ends = random_case(seed, 37)
+        short += int((ends < xs.shape[1]).sum())
+        whole += int((ends == xs.shape[1]).sum())
+    assert short >= 20 and whole >= 20
