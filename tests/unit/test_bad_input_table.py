@@ -159,6 +159,11 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["bench", "perf", "--sections", "", "--out", str(t / "o")], 2,
      "zenav bench perf: --sections is empty; choose from compute, latency, lockstep, engine, "
      "rate"),
+    ("bench perf --rates beyond what the simulator's tick limit lets it measure",
+     lambda t: ["bench", "perf", "--sections", "rate", "--rates", "10,20000",
+                "--out", str(t / "o")], 2,
+     "zenav bench perf: --rates 20000 Hz: at most 7143 Hz, so that a run of 6 s measured "
+     "(--rate-seconds) fits the simulator's 200000 ticks"),
     ("bench crowd --seed below zero",
      lambda t: ["bench", "crowd", "--seed", "-1", "--out", str(t / "o")], 2,
      "zenav bench crowd: argument --seed: must be >= 0 (got -1)"),

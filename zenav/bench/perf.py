@@ -63,7 +63,8 @@ from zenav.bench.lockstep import (
     measure_lockstep,
 )
 from zenav.bench.memory import memory_table
-from zenav.bench.rate import measure_rate, rate_table
+from zenav.bench.rate import highest_rate, measure_rate, rate_table
+from zenav.sim.scenario import MAX_TICKS
 
 SECTIONS = ("compute", "latency", "lockstep", "engine", "rate")
 
@@ -167,6 +168,13 @@ def _command(args: argparse.Namespace) -> int:
     if unknown:
         print(f"zenav bench perf: unknown section {', '.join(unknown)}; choose from "
               f"{', '.join(SECTIONS)}", file=sys.stderr)
+        return 2
+    top = highest_rate(args.rate_seconds)
+    too_fast = [r for r in args.rates if r > top]
+    if "rate" in sections and too_fast:
+        print(f"zenav bench perf: --rates {', '.join(f'{r:g}' for r in too_fast)} Hz: at most "
+              f"{top:.0f} Hz, so that a run of {args.rate_seconds:g} s measured (--rate-seconds) "
+              f"fits the simulator's {MAX_TICKS} ticks", file=sys.stderr)
         return 2
     run_perf(sections, args.out, scans=args.scans,
              obstacle_counts=args.obstacles, latency_seconds=args.latency_seconds,

@@ -8,12 +8,14 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import yaml
 
 from zenav.bench.common import fmt, percentile, verdict
 from zenav.bench.live import live_stack
 from zenav.sim import SCENARIO_DIR
+from zenav.sim.scenario import MAX_TICKS
 
 TARGET_RATE_HZ = 200.0
 
@@ -32,16 +34,41 @@ class RateRow:
                 and self.scans_hz >= 0.95 * self.rate_hz)
 
 
+SETTLE_S = 2.0
+"""s: the stack runs this long before the measurement (links settled, first status in)."""
+SPARE_S = 20.0
+"""s of simulated time beyond the measured ones: start-up, the last status period."""
+
+
+def longest_run(rate: float) -> float:
+    """The longest a run at ``rate`` Hz may last within the simulator's tick limit, s."""
+    return MAX_TICKS / max(rate, 10.0)
+
+
+def highest_rate(seconds: float) -> float:
+    """The highest laser rate whose run still covers ``seconds`` measured, Hz."""
+    return MAX_TICKS / (SETTLE_S + seconds + SPARE_S)
+
+
+def rate_scenario(rate: float, scenario: Path = SCENARIO_DIR / "h-mixed.yaml"
+                  ) -> dict[str, Any]:
+    """``scenario`` with its laser at ``rate`` Hz, lasting as long as the tick limit
+    allows (up to an hour; the run is stopped once measured). For rates up to
+    ``highest_rate`` that covers the measurement."""
+    data: dict[str, Any] = yaml.safe_load(scenario.read_text())
+    data.setdefault("laser", {})["rate_hz"] = rate
+    data["duration"] = math.floor(min(3600.0, longest_run(rate)))
+    return data
+
+
 def measure_rate(rate: float, seconds: float, work: Path,
                  scenario: Path = SCENARIO_DIR / "h-mixed.yaml") -> RateRow:
-    data = yaml.safe_load(scenario.read_text())
-    data.setdefault("laser", {})["rate_hz"] = rate
-    data["duration"] = 3600
+    data = rate_scenario(rate, scenario)
     copy = work / f"rate-{rate:g}.yaml"
     copy.parent.mkdir(parents=True, exist_ok=True)
     copy.write_text(yaml.safe_dump(data))
     with live_stack(copy, work / f"rate-{rate:g}", {}) as (_, listener):
-        time.sleep(2.0)  # links settled, first status messages in
+        time.sleep(SETTLE_S)  # links settled, first status messages in
         before = listener.drops()
         listener.clear()
         started = time.perf_counter()
