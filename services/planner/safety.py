@@ -143,6 +143,13 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
     ``times`` (k,), evenly spaced from one step on. A roll-out that comes within
     ``robot.arrive_within`` of ``robot.goal`` stays at the first point it does: the
     planner stops there, so what lies past the goal is never driven into."""
+    xs, ys, _ = _drive_out(robot, headings, speeds, times)
+    return xs, ys
+
+
+def _drive_out(robot: Robot, headings: Vec, speeds: Vec, times: Vec
+               ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
+    """``rollout``'s positions and ``steps_driven``'s answer for them, found once."""
     n, k = headings.shape[0], times.shape[0]
     xs = np.empty((n, k))
     ys = np.empty((n, k))
@@ -155,7 +162,7 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
         last = np.minimum(np.arange(k)[None, :], ends[:, None] - 1)
         xs = np.take_along_axis(xs, last, axis=1)
         ys = np.take_along_axis(ys, last, axis=1)
-    return xs, ys
+    return xs, ys, ends
 
 
 def steps_driven(robot: Robot, xs: Vec, ys: Vec) -> npt.NDArray[np.int64]:
@@ -285,11 +292,10 @@ def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
     """Roll out each candidate and score its passes by the movers and the map: the
     positions (n, k), the cost, the time of the first contact and its mover. ``inside``:
     ``holding``'s answer for the robot (found here when not given)."""
-    xs, ys = rollout(robot, headings, speeds, times)
+    xs, ys, ends = _drive_out(robot, headings, speeds, times)
     if inside is None:
         inside = holding((robot.x, robot.y), movers, robot.radius, s)
-    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside,
-                                       steps_driven(robot, xs, ys))
+    cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside, ends)
     # Inside the inflation already, the map cannot judge.
     if blocked is not None and not blocked(np.array([[robot.x]]), np.array([[robot.y]]))[0]:
         cost = cost + np.where(blocked(xs, ys), 10.0, 0.0)
