@@ -81,6 +81,16 @@ def test_a_tool_with_a_dead_peer_honours_its_duration(tool: str, tmp_path: Path)
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.parametrize("tool", ["monitor", "record"])
+def test_a_duration_over_before_the_router_answers_says_so(tool: str, tmp_path: Path) -> None:
+    done = run(zenav(*TOOLS[tool](tmp_path), "--connect", nobody(), "--connect-timeout", "30",
+                     "--duration", "1"), timeout=HANG)
+    assert done.returncode == 0, done.stderr
+    last = done.stderr.splitlines()[-1]
+    assert last.startswith(f"zenav {tool}: stopped before the session opened; nothing "), last
+    assert not (tmp_path / "out.mcap").exists()
+
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_replay_waiting_for_a_service_says_so_and_stops_at_once_on_a_signal(
         signum: signal.Signals, tmp_path: Path,

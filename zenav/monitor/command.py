@@ -39,7 +39,9 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
     if duration is not None:
         loop.call_later(duration, stop.set)
     bus = await open_bus(transport, stop, connect_timeout, "zenav monitor")
-    if bus is None:  # stopped while connecting
+    if bus is None:  # stopped (a signal or --duration) while connecting
+        print("zenav monitor: stopped before the session opened; nothing shown",
+              file=sys.stderr)
         return
     subscriber = StampedSubscriber(
         bus, model.keys.everything,
