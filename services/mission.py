@@ -94,6 +94,13 @@ class ScenarioLike(Protocol):
 LIVE_SERVICES = ("laser_driver", "perception", "tracking", "planner", "motor_bridge")
 """The services the simulator waits for besides the run itself."""
 
+SCAN_WAIT = 5.0
+"""Wall s a service holds a message for the scan of its stamp (a planner's track list, the
+motor bridge's command) before going on without it. The scan comes straight from the laser
+driver, the message through other services, so under load it can come first; in lockstep
+runs this bound keeps a loaded machine from changing the result (1 s let a scan come late
+under CI's load and the stack part from the in-process engine)."""
+
 
 def stack_params(
     scenario: ScenarioLike, scenario_path: Path, planner: str = "paper"

@@ -6,6 +6,15 @@ commands go stale. Staleness is judged on the stamps' clock: the latest odometry
 tells the bridge what time it is. In real-time mode a wall-clock watchdog also stops the
 robot when nothing at all arrives (a cut link, a dead planner host).
 
+The stop zone is checked on the scan a command answers (the same stamp). That scan comes
+straight from the laser driver while the command comes through four services, so on a
+loaded machine the command can come first. On the simulator's clock (``clock: sim``), once
+scans come at all, the bridge then holds the command until its scan comes, as the planner
+holds a track list (:class:`~zenav.services.node.StampJoin`: at most ``scan_wait`` wall
+seconds, or until a newer command comes), so a lockstep run does not depend on the
+machine's load. In real-time mode it never holds a command for a late scan: it checks the
+newest scan before the command's stamp.
+
 Backends, chosen by ``backend``: ``native`` sends :class:`BaseCommand` on
 ``device/base_cmd`` (the simulator, or a base's own driver process); ``ros2`` also sends
 each command to a ROS 2 robot's ``cmd_vel`` over rmw_zenoh (:mod:`.output`).
@@ -22,7 +31,7 @@ from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCom
 from zenav.services.motor_bridge.command_filter import CommandFilter, Limiter
 from zenav.services.motor_bridge.output import BaseOutput
 from zenav.services.motor_bridge.params import Params
-from zenav.services.node import Node, StampGate
+from zenav.services.node import Node, StampGate, StampJoin
 from zenav.services.ros2.node import Ros2Node, Ros2Publisher
 
 __all__ = ["CommandFilter", "Limiter", "Params", "Service"]
@@ -53,35 +62,45 @@ class Service:
         self.last_command_stamp: float | None = None
         self.last_command_wall = time.monotonic()
         self.stopped_for_staleness = False
-        self.scans: dict[float, LaserScan] = {}  # the latest few, by stamp
+        # A command and the scan of its stamp, joined (the latest few scans kept).
+        self.join = StampJoin[VelocityCommand, LaserScan](self.apply, params.scan_wait,
+                                                          SCANS_KEPT)
         self.zone_stops = 0
         node.subscribe(keys.SCAN, LaserScan, self.on_scan, depth=2)
         node.subscribe(keys.CMD_VEL, VelocityCommand, self.on_command, depth=2)
         node.subscribe(keys.ODOM, Odometry, self.on_odometry, depth=8)
 
     def on_scan(self, scan: LaserScan) -> None:
-        self.scans[scan.stamp] = scan
-        while len(self.scans) > SCANS_KEPT:
-            del self.scans[min(self.scans)]
+        self.join.companion(scan)
 
     def scan_for(self, stamp: float) -> LaserScan | None:
         """The scan a command answers (same stamp), else the newest one not after it."""
-        if stamp in self.scans:
-            return self.scans[stamp]
-        earlier = [s for s in self.scans if s <= stamp]
-        return self.scans[max(earlier)] if earlier else None
+        scans = self.join.companions
+        if stamp in scans:
+            return scans[stamp]
+        earlier = [s for s in scans if s <= stamp]
+        return scans[max(earlier)] if earlier else None
 
     def on_command(self, command: VelocityCommand) -> None:
         if not self.gate.admit(command.stamp, self.base):
             return
+        if self.params.clock == "sim" and self.params.stop_zone and self.join.companions:
+            self.join.arrive(command)  # applied once its scan is in (see the module notes)
+        else:
+            self.apply(command, None)
+
+    def apply(self, command: VelocityCommand, scan: LaserScan | None) -> None:
+        """Filter ``command`` with the stop zone on ``scan`` (the scan of its stamp), else
+        on the newest scan before it, and send it to the base."""
         if self.stopped_for_staleness:
             log.info("commands resumed at t=%.3f", command.stamp)
             self.stopped_for_staleness = False
         self.last_command_stamp = command.stamp
         self.last_command_wall = time.monotonic()
         self.now = command.stamp if self.now is None else max(self.now, command.stamp)
-        v, omega, reason = self.filter.apply(command.stamp, command.v, command.omega,
-                                             self.scan_for(command.stamp))
+        if scan is None:
+            scan = self.scan_for(command.stamp)
+        v, omega, reason = self.filter.apply(command.stamp, command.v, command.omega, scan)
         if reason == "stop_zone":
             self.zone_stops += 1
             if self.zone_stops == 1 or self.zone_stops % 50 == 0:

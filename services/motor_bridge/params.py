@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import ConfigDict, Field
 
-from zenav.services.mission import ACCEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS
+from zenav.services.mission import ACCEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, SCAN_WAIT
 from zenav.services.motor_bridge.stop_zone import StopZoneParams
 from zenav.services.ros2.params import Ros2Params
 
@@ -35,6 +35,10 @@ class Params(StopZoneParams):
     clock: Literal["sim", "realtime"] = Field(
         "sim", description="'realtime' adds a wall-clock watchdog to the stamp-clock check"
     )
+    scan_wait: float = Field(
+        SCAN_WAIT, gt=0, description="clock 'sim': wall s a command waits for the scan of "
+        "its stamp before its stop zone check uses the newest scan before it (a newer "
+        "command ends the wait sooner); 'realtime' never holds a command for its scan")
     watchdog_period: float = Field(0.05, gt=0, description="wall s between watchdog checks")
     robot_radius: float = Field(ROBOT_RADIUS, gt=0, description="disc footprint, m")
     backend: Literal["native", "ros2"] = Field(

@@ -7,7 +7,15 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from zenav.services.mission import ACCEL, CELL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, WINDOW_RADIUS
+from zenav.services.mission import (
+    ACCEL,
+    CELL,
+    MAX_OMEGA,
+    MAX_SPEED,
+    ROBOT_RADIUS,
+    SCAN_WAIT,
+    WINDOW_RADIUS,
+)
 from zenav.services.motor_bridge.stop_zone import StopZoneParams
 
 
@@ -24,12 +32,10 @@ class MissionParams(BaseModel):
     )
     goal_tolerance: float = Field(0.25, gt=0, description="arrived within this distance, m")
     scan_wait: float = Field(
-        5.0, gt=0, description="wall s the planner waits for the scan of a track list's "
-        "stamp before deciding without it (the paper planner: without a map update or a "
-        "stop zone check; a baseline: on the newest scan before); in real time the next "
-        "track list (0.1 s later at 10 Hz) ends the wait sooner, so this bound matters in "
-        "lockstep runs, where it keeps a loaded machine from changing the result (1 s let "
-        "a scan come late under CI's load and the stack part from the in-process engine)"
+        SCAN_WAIT, gt=0, description="wall s the planner waits for the scan of a track "
+        "list's stamp before deciding without it (the paper planner: without a map update "
+        "or a stop zone check; a baseline: on the newest scan before); in real time the "
+        "next track list (0.1 s later at 10 Hz) ends the wait sooner"
     )
 
     # --- the robot ------------------------------------------------------------------

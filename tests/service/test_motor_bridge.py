@@ -1,14 +1,17 @@
-"""The motor bridge on the in-memory bus: limits, stale-command stop, bad input."""
+"""The motor bridge on the in-memory bus: limits, stale-command stop, the stop zone's
+scan, bad input."""
 
 from __future__ import annotations
 
 import asyncio
+import math
 
+import numpy as np
 import pytest
 
 from tests.service.harness import running
 from zenav.schemas import keys
-from zenav.schemas.messages import BaseCommand, Odometry, Pose2D, VelocityCommand
+from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, Pose2D, VelocityCommand
 from zenav.services.motor_bridge.params import Params
 
 
@@ -100,3 +103,54 @@ async def test_a_burst_keeps_only_the_newest_commands_and_counts_the_drop():
         stamps = [c.stamp for c in h.received(keys.BASE_CMD, BaseCommand)]
         assert stamps == [3.0, 4.0]
         assert h.node.status().dropped == {"zenav/test/cmd_vel": 2}
+
+
+def scan(t: float, ahead: float = 8.0) -> LaserScan:
+    """A 180° scan, clear to 8 m but for a return ``ahead`` m straight ahead."""
+    ranges = np.full(361, 8.0, dtype=np.float32)
+    ranges[178:183] = ahead
+    return LaserScan(stamp=t, seq=0, frame="laser", angle_min=-math.pi / 2,
+                     angle_max=math.pi / 2, angle_increment=math.radians(0.5), range_min=0.05,
+                     range_max=8.0, ranges=ranges)
+
+
+async def test_on_the_sim_clock_a_command_before_its_scan_waits_for_it():
+    """The command's scan, with a return just ahead, comes after the command (a loaded
+    machine): the stop zone is checked on it, not on the clear scan before."""
+    async with running("motor_bridge", Params(accel=10.0)) as h:
+        h.send(keys.SCAN, scan(0.0))
+        h.send(keys.CMD_VEL, cmd(0.0, 0.1))
+        await h.settle()
+        h.send(keys.CMD_VEL, cmd(0.1, 0.1))
+        await h.settle()
+        assert [c.stamp for c in h.received(keys.BASE_CMD, BaseCommand)] == [0.0]  # held
+        h.send(keys.SCAN, scan(0.1, ahead=0.3))
+        await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+    assert [(c.stamp, c.reason) for c in out] == [(0.0, "command"), (0.1, "stop_zone")]
+    assert out[-1].v == 0.0
+
+
+async def test_a_held_command_goes_on_the_scan_before_once_overtaken_or_after_the_wait():
+    async with running("motor_bridge", Params(accel=10.0, scan_wait=0.05)) as h:
+        h.send(keys.SCAN, scan(0.0, ahead=0.3))
+        h.send(keys.CMD_VEL, cmd(0.1, 0.1))
+        h.send(keys.CMD_VEL, cmd(0.2, 0.1))  # overtakes 0.1, whose scan never came
+        await h.settle()
+        assert [c.stamp for c in h.received(keys.BASE_CMD, BaseCommand)] == [0.1]
+        await asyncio.sleep(0.15)  # 0.2's scan does not come within scan_wait either
+        await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+    assert [(c.stamp, c.reason) for c in out] == [(0.1, "stop_zone"), (0.2, "stop_zone")]
+
+
+async def test_in_realtime_mode_a_command_is_never_held_for_its_scan():
+    params = Params(clock="realtime", accel=10.0, stale_timeout=5.0)
+    async with running("motor_bridge", params) as h:
+        h.send(keys.SCAN, scan(0.0))
+        h.send(keys.CMD_VEL, cmd(0.1, 0.1))  # checked at once, on the scan of 0.0
+        await h.settle()
+        h.send(keys.SCAN, scan(0.1, ahead=0.3))
+        await h.settle()
+        out = h.received(keys.BASE_CMD, BaseCommand)
+    assert [(c.stamp, c.reason) for c in out] == [(0.1, "command")]
