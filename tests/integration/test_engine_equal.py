@@ -1,5 +1,6 @@
 """The in-process engine against the stack: the same trajectory, row by row, and the same
-events, on the eight paper scenarios, the paper's experiments and seeded random worlds.
+events, on the eight paper scenarios, the paper's experiments, seeded random worlds and
+CrowdNav cases with ORCA agents.
 
 The stack (six processes over Zenoh) is the acceptance path; the in-process engine
 (``zenav run --engine inprocess``, :mod:`zenav.engine`) is what sweeps use, so it must
@@ -17,6 +18,7 @@ import pytest
 from zenav.engine import first_difference
 from zenav.run import run_scenario
 from zenav.sim import SCENARIO_DIR
+from zenav.sim.crowdnav import crowdnav_scenario
 from zenav.sim.generate import random_scenario
 from zenav.sim.scenario import dump_scenario
 
@@ -25,16 +27,21 @@ pytestmark = pytest.mark.integration
 PAPER = sorted(SCENARIO_DIR.glob("[a-h]-*.yaml"))
 EXPERIMENTS = sorted(SCENARIO_DIR.glob("paper-*.yaml"))
 RANDOM = (("static", 7), ("crossing", 8), ("head-on", 9), ("mixed", 10))
-AGENT_WORLDS: tuple[tuple[str, int], ...] = ()
-"""Worlds with agents (obstacles with a behaviour of their own) join here once the
-simulator has them: (family, seed) pairs of :func:`random_scenario`, e.g. the crowd
-family with agents, run exactly like ``RANDOM``."""
+AGENT_WORLDS = (("circle", 3, False, 360.0), ("square", 5, True, 180.0))
+"""Worlds with agents (ORCA walkers with goals of their own): CrowdNav test cases
+(layout, case, humans see the robot, laser field of view), one of each layout and
+setting kind."""
+
 
 def _worlds(tmp: Path) -> list[Path]:
     paths = [*PAPER, *EXPERIMENTS]
-    for family, seed in (*RANDOM, *AGENT_WORLDS):
+    for family, seed in RANDOM:
         scenario = random_scenario(family, seed, noise_std=0.01)
         paths.append(dump_scenario(scenario, tmp / f"{family}-{seed}.yaml"))
+    for layout, case, visible, fov in AGENT_WORLDS:
+        crowd = crowdnav_scenario(layout, case, visible=visible, fov_deg=fov)
+        assert any(o.behavior == "orca" for o in crowd.obstacles)
+        paths.append(dump_scenario(crowd, tmp / f"{crowd.name}.yaml"))
     return paths
 
 
