@@ -170,15 +170,18 @@ class Service:
             self.history.append(self.events.publish(PlannerEvent(
                 stamp=tracks.stamp, seq=self.events.next_seq(), obstacle=obstacle,
                 kind=kind, scenario=letter, action=action, detail=detail)))
+        # The path before the command: the command leads, through the motor bridge and the
+        # simulator, to the run's result, and a path sent after it could reach the run's
+        # recorder behind the result of a run that ends on this tick.
+        self.publish_path(tracks.stamp)
         self.commands.publish(VelocityCommand(stamp=tracks.stamp, seq=self.commands.next_seq(),
                                               v=decision.v, omega=decision.omega))
         self.state.publish(PlannerState(
             stamp=tracks.stamp, seq=self.state.next_seq(), scenario=decision.scenario,
             action=decision.action, target=decision.target, speed=decision.speed))
-        self.publish_path_and_map(tracks.stamp)
+        self.publish_map(tracks.stamp)
 
-    def publish_path_and_map(self, stamp: float) -> None:
-        self.publish_path(stamp)
+    def publish_map(self, stamp: float) -> None:
         costmap = self.planner.costmap
         if costmap is not None and stamp - self.map_sent >= self.params.map_period:
             self.map_sent = stamp
