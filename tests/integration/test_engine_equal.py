@@ -18,7 +18,7 @@ import pytest
 from zenav.engine import first_difference
 from zenav.run import run_scenario
 from zenav.sim import SCENARIO_DIR
-from zenav.sim.crowdnav import crowdnav_scenario
+from zenav.sim.crowdnav import Layout, crowdnav_scenario
 from zenav.sim.generate import random_scenario
 from zenav.sim.scenario import dump_scenario
 
@@ -27,7 +27,8 @@ pytestmark = pytest.mark.integration
 PAPER = sorted(SCENARIO_DIR.glob("[a-h]-*.yaml"))
 EXPERIMENTS = sorted(SCENARIO_DIR.glob("paper-*.yaml"))
 RANDOM = (("static", 7), ("crossing", 8), ("head-on", 9), ("mixed", 10))
-AGENT_WORLDS = (("circle", 3, False, 360.0), ("square", 5, True, 180.0))
+AGENT_WORLDS: tuple[tuple[Layout, int, bool, float], ...] = (
+    ("circle", 3, False, 360.0), ("square", 5, True, 180.0))
 """Worlds with agents (ORCA walkers with goals of their own): CrowdNav test cases
 (layout, case, humans see the robot, laser field of view), one of each layout and
 setting kind."""
