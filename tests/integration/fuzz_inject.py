@@ -247,14 +247,33 @@ def main(argv: list[str] | None = None) -> int:
         except Exception:  # our own fuzz, or anything else: not a clock reading
             pass
 
+    # Every service that reads a fuzzed key must be linked to this session before the
+    # fuzz is armed. This session opens before the stack and connects to each service's
+    # port on Zenoh's retries, which back off to seconds apart; peers relay nothing, so
+    # a put made before the link to a service is up never reaches it, uncounted.
+    readers = {name for names in SUBSCRIBERS.values() for name in names}
+    linked: set[str] = set()
+
+    def on_alive(sample_: Any) -> None:
+        if sample_.kind == zenoh.SampleKind.PUT:
+            linked.add(str(sample_.key_expr).rsplit("/", 1)[-1])
+
     conf = loopback_mesh(None, args.base_port).to_zenoh()
     with zenoh.open(conf) as session:
         sub = session.declare_subscriber(k.of(keys.ODOM), on_odom)
+        alive = session.liveliness().declare_subscriber(k.alive_any, on_alive, history=True)
         pubs = {t.name: session.declare_publisher(  # BLOCK: delivered, never lost on the way
             k.of(t), congestion_control=zenoh.CongestionControl.BLOCK) for t in FUZZED}
+        deadline = time.monotonic() + 120
+        while not (readers <= linked
+                   and all(pub.matching_status.matching for pub in pubs.values())):
+            if time.monotonic() > deadline:
+                print(f"fuzz: no link to {', '.join(sorted(readers - linked)) or 'a reader'} "
+                      "in 120 s", file=sys.stderr)
+                return 1
+            time.sleep(0.01)
         # The watching test holds the simulation back until this token is up.
         token = session.liveliness().declare_token(k.alive("fuzz"))
-        deadline = time.monotonic() + 120
         while latest[0] < args.after:
             if time.monotonic() > deadline:
                 print("fuzz: the simulation never started", file=sys.stderr)
@@ -272,6 +291,7 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.monotonic() - started
         stamp_at_end = latest[0]
         sub.undeclare()  # type: ignore[no-untyped-call]
+        alive.undeclare()  # type: ignore[no-untyped-call]
         token.undeclare()  # type: ignore[no-untyped-call]
         for pub in pubs.values():
             pub.undeclare()  # type: ignore[no-untyped-call]
