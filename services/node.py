@@ -17,7 +17,7 @@ import inspect
 import logging
 import time
 from collections import Counter
-from collections.abc import Awaitable, Callable, Coroutine
+from collections.abc import Awaitable, Callable, Coroutine, Mapping
 from typing import Any, Generic, Protocol, TypeVar
 
 from zenav.schemas.codec import DecodeError, decode, encode
@@ -363,6 +363,15 @@ class Stamped(Protocol):
 
 A = TypeVar("A", bound=Message)
 B = TypeVar("B", bound=Stamped)
+
+
+def latest_at(kept: Mapping[float, object], stamp: float) -> float | None:
+    """The stamp of the kept message for ``stamp``: the same, else the newest before it
+    (what a message decided without its companion falls back to)."""
+    if stamp in kept:
+        return stamp
+    earlier = [s for s in kept if s <= stamp]
+    return max(earlier) if earlier else None
 
 
 class StampJoin(Generic[A, B]):

@@ -45,7 +45,7 @@ from zenav.services.baselines.dwa import DWA
 from zenav.services.baselines.orca import ORCA
 from zenav.services.baselines.params import APFParams, DWAParams, ORCAParams, VFHParams
 from zenav.services.baselines.vfh import VFH
-from zenav.services.node import Node, StampGate, StampJoin
+from zenav.services.node import Node, StampGate, StampJoin, latest_at
 from zenav.services.planner.params import MissionParams
 
 KEPT = 8
@@ -89,14 +89,6 @@ class Instant:
     stamp: float
     scan: LaserScan
     odometry: Odometry | None
-
-
-def latest_at(kept: dict[float, LaserScan] | dict[float, Odometry], stamp: float) -> float | None:
-    """The stamp of the kept message for ``stamp``: the same, else the newest before it."""
-    if stamp in kept:
-        return stamp
-    earlier = [s for s in kept if s <= stamp]
-    return max(earlier) if earlier else None
 
 
 class BaselineService:

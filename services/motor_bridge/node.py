@@ -31,7 +31,7 @@ from zenav.schemas.messages import BaseCommand, LaserScan, Odometry, VelocityCom
 from zenav.services.motor_bridge.command_filter import CommandFilter, Limiter
 from zenav.services.motor_bridge.output import BaseOutput
 from zenav.services.motor_bridge.params import Params
-from zenav.services.node import Node, StampGate, StampJoin
+from zenav.services.node import Node, StampGate, StampJoin, latest_at
 from zenav.services.ros2.node import Ros2Node, Ros2Publisher
 
 __all__ = ["CommandFilter", "Limiter", "Params", "Service"]
@@ -73,14 +73,6 @@ class Service:
     def on_scan(self, scan: LaserScan) -> None:
         self.join.companion(scan)
 
-    def scan_for(self, stamp: float) -> LaserScan | None:
-        """The scan a command answers (same stamp), else the newest one not after it."""
-        scans = self.join.companions
-        if stamp in scans:
-            return scans[stamp]
-        earlier = [s for s in scans if s <= stamp]
-        return scans[max(earlier)] if earlier else None
-
     def on_command(self, command: VelocityCommand) -> None:
         if not self.gate.admit(command.stamp, self.base):
             return
@@ -99,7 +91,8 @@ class Service:
         self.last_command_wall = time.monotonic()
         self.now = command.stamp if self.now is None else max(self.now, command.stamp)
         if scan is None:
-            scan = self.scan_for(command.stamp)
+            at = latest_at(self.join.companions, command.stamp)
+            scan = None if at is None else self.join.companions[at]
         v, omega, reason = self.filter.apply(command.stamp, command.v, command.omega, scan)
         if reason == "stop_zone":
             self.zone_stops += 1

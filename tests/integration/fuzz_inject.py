@@ -265,8 +265,8 @@ def main(argv: list[str] | None = None) -> int:
         pubs = {t.name: session.declare_publisher(  # BLOCK: delivered, never lost on the way
             k.of(t), congestion_control=zenoh.CongestionControl.BLOCK) for t in FUZZED}
         deadline = time.monotonic() + 120
-        # (zenoh's stub types matching_status as a bool; it is a MatchingStatus object,
-        # always truthy, whose .matching says it)
+        # Zenoh's type stub says matching_status is a bool. At runtime it is a
+        # MatchingStatus object, always truthy, and its .matching field holds the answer.
         while not (readers <= linked and all(
                 pub.matching_status.matching for pub in pubs.values())):  # type: ignore[attr-defined]
             if time.monotonic() > deadline:
