@@ -239,6 +239,12 @@ def loopback_port(service: str, base_port: int = DEFAULT_BASE_PORT) -> int:
     return base_port + SERVICE_ORDER.index(service)
 
 
+def tool_port(base_port: int = DEFAULT_BASE_PORT) -> int:
+    """The loopback mesh's port for a tool, after the services' own: every service
+    connects to it, and the first tool to come listens on it."""
+    return base_port + len(SERVICE_ORDER)
+
+
 def loopback_mesh(
     service: str | None, base_port: int = DEFAULT_BASE_PORT, *, tool_listens: bool = False
 ) -> TransportConfig:
@@ -246,11 +252,12 @@ def loopback_mesh(
     all the others and to the tool port after them (``base_port + 6``).
 
     ``service=None`` is a tool (zenav run, a monitor): it connects to every service. The
-    one tool that drives a run also listens on the tool port (``tool_listens``), so the
-    links to it are made from both ends and come up as soon as either side starts.
+    tool that drives a run, and any tool that finds the tool port free, also listens on
+    it (``tool_listens``), so the links to it are made from both ends and come up as
+    soon as either side starts.
     """
     endpoints = {name: f"tcp/127.0.0.1:{loopback_port(name, base_port)}" for name in SERVICE_ORDER}
-    tool = f"tcp/127.0.0.1:{base_port + len(SERVICE_ORDER)}"
+    tool = f"tcp/127.0.0.1:{tool_port(base_port)}"
     if service is None:
         return TransportConfig(mode="peer", listen=[tool] if tool_listens else [],
                                connect=list(endpoints.values()))

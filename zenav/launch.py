@@ -15,7 +15,7 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,19 +34,26 @@ def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) ->
     rng = random.Random(os.getpid() ^ time.monotonic_ns())
     for _ in range(attempts):
         base = rng.randrange(20000, 32000 - count)
-        sockets = []
-        try:
-            for port in range(base, base + count):
-                s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-                sockets.append(s)
-                s.bind(("127.0.0.1", port))
+        if loopback_ports_free(range(base, base + count)):
             return base
-        except OSError:
-            continue
-        finally:
-            for s in sockets:
-                s.close()
     raise RuntimeError("no free block of loopback ports found")
+
+
+def loopback_ports_free(ports: Iterable[int]) -> bool:
+    """Whether every one of ``ports`` can be bound on 127.0.0.1 now (they are released
+    again at once: another process may take one before the caller does)."""
+    sockets = []
+    try:
+        for port in ports:
+            s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sockets.append(s)
+            s.bind(("127.0.0.1", port))
+        return True
+    except OSError:
+        return False
+    finally:
+        for s in sockets:
+            s.close()
 
 
 def write_params(directory: Path, service: str, params: Mapping[str, Any]) -> Path:

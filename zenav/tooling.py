@@ -20,7 +20,7 @@ from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 from zenav.argtypes import positive_float
-from zenav.services.config import ConfigError, read_transport
+from zenav.services.config import ConfigError, read_transport, tool_port
 from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
@@ -68,8 +68,51 @@ def tool_transport(args: argparse.Namespace) -> TransportConfig:
             config = config.model_copy(update={"mode": args.mode})
         config = with_client_defaults(config)
     else:
-        config = with_client_defaults(transport_from_args(args, None))
+        config = transport_from_args(args, None)
+        if not (args.listen or args.connect) and config.mode == "peer":
+            config = on_the_mesh(config, args.base_port)
+        config = with_client_defaults(config)
     return with_connect_timeout(config, getattr(args, "connect_timeout", CONNECT_TIMEOUT))
+
+
+MESH_RETRY: dict[str, Any] = {
+    "connect/retry": {"period_init_ms": 100, "period_max_ms": 1000, "period_increase_factor": 2.0},
+}
+"""How often a tool on the loopback mesh tries a service that is not up yet: from every
+0.1 s, backing off to 1 s (Zenoh's default starts at 1 s and backs off to 4 s). A refused
+connection on loopback costs next to nothing."""
+
+
+class MeshTool(TransportConfig):
+    """A tool's transport on the loopback mesh (:func:`on_the_mesh`). Its ``listen`` is
+    the mesh's tool port when that port was free as the options were read; if another
+    process binds it before this session opens, :func:`open_bus` opens the session
+    without listening (:meth:`connecting_only`)."""
+
+    def connecting_only(self) -> TransportConfig:
+        return TransportConfig.model_validate({**self.model_dump(), "listen": []})
+
+
+def on_the_mesh(config: TransportConfig, base_port: int) -> MeshTool:
+    """A tool's loopback-mesh transport (``config``, from :func:`loopback_mesh`), made to
+    hear each service from that service's first message.
+
+    A tool that only connects reaches a service started after it at its next connection
+    attempt, and misses what the service sends before then: a recorder started first
+    could miss the planner's first global path and event, and seconds of the simulator's
+    odometry. Every service connects to the mesh's tool port from its start, so the tool
+    listens there when the port is free, and then a service's link to it is made before
+    the service sends anything. A second tool finds the port taken and connects only, as
+    does one that loses the port to another tool started in the same instant
+    (:func:`open_bus` then opens its session without listening). Either way it tries
+    services that are not up yet more often (:data:`MESH_RETRY`).
+    """
+    from zenav.launch import loopback_ports_free
+
+    port = tool_port(base_port)
+    listen = [f"tcp/127.0.0.1:{port}"] if loopback_ports_free([port]) else []
+    return MeshTool.model_validate({**config.model_dump(), "listen": listen,
+                                    "extra": {**MESH_RETRY, **config.extra}})
 
 
 def with_connect_timeout(config: TransportConfig, timeout: float) -> TransportConfig:
@@ -147,7 +190,13 @@ async def open_bus(transport: TransportConfig, stop: asyncio.Event,
         session: Any = None
         error: BaseException | None = None
         try:
-            session = zenoh.open(conf)
+            try:
+                session = zenoh.open(conf)
+            except Exception:
+                if not (isinstance(transport, MeshTool) and transport.listen):
+                    raise
+                # Another tool took the mesh's tool port since the options were read.
+                session = zenoh.open(transport.connecting_only().to_zenoh())
         except Exception as exc:  # handed to the loop
             error = exc
         finally:

@@ -97,7 +97,7 @@ def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: 
     lie on y = 3 and the robot drives along y = 3."""
     from zenav.bag.mcapfile import read_bag
     from zenav.schemas.codec import decode
-    from zenav.schemas.messages import GlobalPath, Odometry, PlannerState
+    from zenav.schemas.messages import GlobalPath, Message, Odometry, PlannerEvent, PlannerState
     from zenav.sim.scenario import load_scenario
 
     scenario = load_scenario(REPO / SCENARIO)
@@ -157,9 +157,20 @@ def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: 
     # SIGINT: the services end cleanly with 0, the recorder (a tool) with 130
     assert codes == {name: 130 if name == "record" else 0 for name in procs}, codes
     goal = list(scenario.robot.goal)
-    # The global path is published once, at the planner's first decision, and a recorder
-    # in this peer setup does not always hear that first message (an open fault, see the
-    # README's known limits); when it does, the path must end at the scenario's goal.
+    # The recorder, started first, is linked to each service as that service starts: the
+    # planner's first state, global path and event (all sent at its first decision, the
+    # event only then) are in the bag. The simulator sends odometry as soon as the
+    # services are alive, which can be before its link to the recorder is up on a loaded
+    # machine, so its first odometry is not required.
+    kinds: dict[str, type[Message]] = {
+        "odom": Odometry, "planner/state": PlannerState, "planner/path": GlobalPath,
+        "planner/events": PlannerEvent}
+    first: dict[str, Message] = {}
+    for message in read_bag(bag, set(kinds)):
+        first.setdefault(message.topic, decode(message.payload, kinds[message.topic]))
+    seqs = {topic: m.seq for topic, m in first.items()}
+    assert "odom" in seqs and {topic: seqs.get(topic) for topic in kinds if topic != "odom"} \
+        == {"planner/state": 0, "planner/path": 0, "planner/events": 0}, seqs
     paths = [decode(m.payload, GlobalPath) for m in read_bag(bag, {"planner/path"})]
     assert all(path.points[-1].tolist() == goal for path in paths), paths[-1].points
     targets = [decode(m.payload, PlannerState).target for m in read_bag(bag, {"planner/state"})]
