@@ -241,8 +241,10 @@ def closed_off(const unsigned char[::1] walls, Py_ssize_t nx, Py_ssize_t ny,
     walls), a way is a run of free cells each beside the last (4 neighbours, as
     ``scipy.ndimage.label``'s default joins them), and a cell's window is the cells at
     most ``reach`` from it along each axis (within the grid). A flood from the free
-    cells of the start's window, stopping at the first cell of the goal's."""
+    cells of the start's window, stopping at the first cell of the goal's. A goal whose
+    window holds no free cell at all is not closed off but covered: False."""
     cdef Py_ssize_t size = nx * ny, c, i, j, k, head = 0, tail = 0, a, b
+    cdef bint covered
     state_array = np.zeros(size, dtype=np.uint8)  # 0 free, 1 blocked, 2 reached
     queue_array = np.empty((size, 2), dtype=np.int32)  # (i, j) of the cells reached
     cdef unsigned char[::1] state = state_array
@@ -255,6 +257,13 @@ def closed_off(const unsigned char[::1] walls, Py_ssize_t nx, Py_ssize_t ny,
                     b = j + dj[k]
                     if (<size_t>a < <size_t>nx) & (<size_t>b < <size_t>ny):
                         state[a * ny + b] = 1
+    covered = True
+    for i in range(max(gi - reach, 0), min(gi + reach + 1, nx)):
+        for j in range(max(gj - reach, 0), min(gj + reach + 1, ny)):
+            if state[i * ny + j] == 0:
+                covered = False
+    if covered:
+        return False
     for i in range(max(si - reach, 0), min(si + reach + 1, nx)):
         for j in range(max(sj - reach, 0), min(sj + reach + 1, ny)):
             if state[i * ny + j] == 0:

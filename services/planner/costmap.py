@@ -285,9 +285,11 @@ class Costmap:
         cells (every cell centre farther than ``clearance`` from the remembered walls)
         joins the free cells within ``clearance`` plus a cell of the start to those near
         the goal. Unknown cells count as free, so this errs toward a way: only walls seen
-        close the goal off. A mark on the goal's own cell is not enough (a mover passing
-        over the goal leaves one until a beam clears it): the map's "goal occupied"
-        answers that, after a stall."""
+        close the goal off. Marks on the goal's own cells are not enough: a goal whose
+        cells near it are all within ``clearance`` of walls is covered, not closed off.
+        A mover passing over the goal leaves such marks until a beam clears them, and a
+        slow one walking toward the robot, on the way, keeps the beams off them. The
+        map's "goal occupied" answers a covered goal, after a stall."""
         ends = self.cell_of(np.vstack([start, goal]))
         if not self.inside(ends).all():
             return False  # beyond the grid: no knowledge, no verdict

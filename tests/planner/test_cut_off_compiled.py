@@ -33,7 +33,10 @@ def scipy_cut_off(cm: Costmap, start: npt.NDArray[np.float64], goal: npt.NDArray
         window = labels[max(i - reach, 0):i + reach + 1, max(j - reach, 0):j + reach + 1]
         return set(np.unique(window[window > 0]).tolist())
 
-    return not near(ends[0]) & near(ends[1])
+    at_goal = near(ends[1])
+    if not at_goal:
+        return False  # no free cell near the goal: covered, not closed off
+    return not near(ends[0]) & at_goal
 
 
 def walled(rng: np.random.Generator, nx: int, ny: int) -> npt.NDArray[np.bool_]:

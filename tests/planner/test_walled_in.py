@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 
 from tests.planner.scans import Box, scan_of
 from zenav.services.planner.costmap import Costmap
@@ -115,6 +116,31 @@ def test_a_mover_passing_over_the_goal_never_cuts_it_off() -> None:
         disc = (10.0 - 0.1 * t, 3.0, 0.2)
         m.update(scan_of(pose, discs=[disc]), t)
         assert not m.cut_off(np.array(pose[:2]), np.array(GOAL), 0.2), t
+
+
+def test_a_goal_covered_by_a_mover_s_marks_is_not_cut_off() -> None:
+    """The wall memory of bench nav's head-on-31017 (180° laser) at 15 s: a slow disc
+    appeared 1 m past the goal and walked over it toward the robot, leaving a band of
+    marks 0.3 m by 0.9 m over the goal, which the disc itself, on the line, keeps the
+    beams off. No cell near the goal is free, but nothing closes the goal off: it is
+    covered. (This used to cut the goal off; the planner gave it up at 50 s and stood
+    until the mover walked into it.)"""
+    goal, robot = np.array([1.693, 6.073]), np.array([7.07, 5.78])
+    p = Params()
+    m = Costmap(tuple(robot), tuple(goal), resolution=p.map_resolution, decay=p.map_decay,
+                inflation=p.robot_radius + p.safety_margin, confirm=p.map_confirm,
+                padding=p.map_padding, max_size=p.map_max_size)
+    band = np.array([(x, y) for x in np.arange(1.15, 1.96, 0.1) for y in (5.95, 6.05, 6.15)])
+    cells = m.cell_of(band)
+    m.walls[cells[:, 0], cells[:, 1]] = True
+    reach = math.ceil(0.2 / m.resolution) + 1
+    gi, gj = m.cell_of(goal[None, :])[0].tolist()
+    free = distance_transform_edt(~m.walls) * m.resolution > 0.2
+    assert not free[gi - reach:gi + reach + 1, gj - reach:gj + reach + 1].any()  # covered
+    assert not m.cut_off(robot, goal, 0.2)
+    # A goal 1 m off the band, its own cells free, is not closed off either (a closed
+    # ring does close a goal off: the tests above).
+    assert not m.cut_off(robot, goal + np.array([0.0, 1.0]), 0.2)
 
 
 # -- the planner: recovery ends in unreachable ----------------------------------------------
