@@ -20,7 +20,7 @@ from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 from zenav.argtypes import positive_float
-from zenav.services.config import ConfigError, read_transport, tool_port
+from zenav.services.config import ConfigError, loopback_mesh, read_transport, tool_port
 from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
@@ -109,8 +109,8 @@ def on_the_mesh(config: TransportConfig, base_port: int) -> MeshTool:
     """
     from zenav.launch import loopback_ports_free
 
-    port = tool_port(base_port)
-    listen = [f"tcp/127.0.0.1:{port}"] if loopback_ports_free([port]) else []
+    free = loopback_ports_free([tool_port(base_port)])
+    listen = loopback_mesh(None, base_port, tool_listens=free).listen
     return MeshTool.model_validate({**config.model_dump(), "listen": listen,
                                     "extra": {**MESH_RETRY, **config.extra}})
 
