@@ -220,8 +220,9 @@ class Planner:
             self.path, s0 + p.lookahead, lengths)
         if len(self.path) > 2 and not self._chord_clear(robot, default):
             # The path bends within the look-ahead and the chord would cut the corner
-            # into what the map holds: steer for the bend itself first.
-            k = int(np.searchsorted(lengths, s0 + 1e-6, side="right"))
+            # into what the map holds: steer for the bend itself first; one a map cell
+            # past the robot at least (a robot at the bend, steering for the bend, stands).
+            k = int(np.searchsorted(lengths, s0 + p.map_resolution, side="right"))
             if k < len(self.path):
                 default = self.path[k]
         if not statics or off_path < p.cell / 2:

@@ -464,6 +464,22 @@ def test_round_a_bend_the_robot_steers_for_the_corner_while_its_returns_are_youn
         assert p.path_target(robot) == pytest.approx(want)
 
 
+def test_standing_at_a_bend_the_robot_steers_past_it() -> None:
+    """At a bend of its path, the chord to the look-ahead point cut by what the map holds
+    (here on the path itself: a slow walker typed static, in paper-mixed): the robot
+    steers for the next bend, where the local layer meets the obstacle. Steering for the
+    bend it stands on, it stood there until recovery (10 s in paper-mixed)."""
+    pose = (2.995, 3.0, 0.0)  # 5 mm short of the bend at (3, 3)
+    robot = np.array(pose[:2])
+    bent = np.array([[2.0, 3.0], [3.0, 3.0], [3.0, 5.0], [8.0, 5.0]])
+    p = planner()
+    p.update_map(pose, [], scan_of(pose, boxes=[(2.9, 3.5, 3.1, 3.7)]), 0.0)
+    p.update_map(pose, [], scan_of(pose, boxes=[(2.9, 3.5, 3.1, 3.7)]), 2.0)  # confirmed
+    p._set_path(bent, "test")
+    assert not p._chord_clear(robot, np.array([3.0, 4.0]))  # the look-ahead point's chord
+    assert p.path_target(robot) == pytest.approx((3.0, 5.0))
+
+
 def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
     """Off the path, the robot rejoins it at the farthest point its boxes let it reach in
     a straight line; a return the map holds on that straight way (not a track, so not in
