@@ -767,6 +767,13 @@ class Planner:
                                       to_goal=True)
             if reached or not any(a.threat and a.letter in "bf" for a in direct):
                 self.detour = None
+                # The way back is judged on a path from here: the cycle's own check ran
+                # while the detour was under way, and the old path's rejoin point can lie
+                # behind the obstacle just passed, on its far side.
+                count = self.plan_count
+                self.update_path(robot, stamp)
+                if self.plan_count != count:
+                    path_target = self.path_target(robot, self._statics(in_window))
 
         target = self.detour.subtarget if self.detour is not None else path_target
         # On a detour, only a clear obstruction of the way to the sub-target re-plans it,

@@ -14,7 +14,7 @@ import pytest
 from tests.planner.scans import scan_of
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
-from zenav.services.planner.decide import SPEED_GAP, Decision, Planner
+from zenav.services.planner.decide import SPEED_GAP, Decision, Detour, Planner
 from zenav.services.planner.global_path import point_at, project
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
@@ -478,6 +478,24 @@ def test_standing_at_a_bend_the_robot_steers_past_it() -> None:
     p._set_path(bent, "test")
     assert not p._chord_clear(robot, np.array([3.0, 4.0]))  # the look-ahead point's chord
     assert p.path_target(robot) == pytest.approx((3.0, 5.0))
+
+
+def test_the_way_back_from_a_detour_is_planned_from_where_the_detour_ends() -> None:
+    """A detour that ends with the robot off the path: the same cycle plans the path again
+    from where the robot stands and steers for a point on it. The old path's rejoin point
+    can lie on the far side of the obstacle just passed, and a new detour toward it takes
+    the robot back round that obstacle (CrowdNav case 1658, docs/navigation.md)."""
+    pose = (2.0, 3.0, 0.0)
+    p = planner()
+    p.step(pose, [], 0.0, scan_of(pose))
+    assert p.path is not None and p.plan_count == 1  # the straight line, (2, 3) -> (8, 3)
+    aside = (4.0, 4.2, 0.0)  # 1.2 m left of it, where the detour's sub-target was
+    p.detour = Detour(np.array(aside[:2]), obstacle=1, letter="b", side=1)
+    d = p.step(aside, [], 0.1, scan_of(aside))
+    assert p.detour is None and p.plan_count == 2
+    assert p.plan is not None and p.plan.reason == "off the path"
+    assert p.path[0] == pytest.approx(aside[:2], abs=p.p.map_resolution)
+    assert project(p.path, np.array(d.target), p.lengths)[1] == pytest.approx(0.0, abs=1e-6)
 
 
 def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
