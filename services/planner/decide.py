@@ -969,7 +969,7 @@ class Planner:
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
         if self.recovery.unreachable:
-            return self._record(Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0))
+            return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
 
         self.update_map(pose, obstacles, scan, stamp)
         self.update_path(robot, stamp)
@@ -1011,6 +1011,32 @@ class Planner:
                     decision = self.recover(pose, stamp, scan) or decision
         return self._record(decision)
 
+    def given_up(self, pose: tuple[float, float, float], obstacles: list[Obstacle]) -> Decision:
+        """The command once the goal is unreachable: stand, unless a walker would walk
+        into the robot standing (``walked_into``). Then the speed and safety stage's fan
+        picks the cheapest way out of its way, its progress measured to the spot where
+        the robot stands (the least move that keeps clear), and the robot takes it this
+        cycle (action ``give_way``); it stands again once the walker has passed."""
+        goal_xy = (float(self.goal[0]), float(self.goal[1]))
+        standing = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
+        walkers = self._walkers_at(pose, obstacles)
+        if not walkers or not self._walks_into(pose, walkers):
+            return standing
+        p = self.p
+        here = np.array(pose[:2], dtype=np.float64)
+        robot, group, _, blocked = self._safety_inputs(pose, here, walkers, None)
+        choice = safety.choose(robot, (pose[2], 0.0), group, here, blocked, None,
+                               self.safety_settings)
+        if choice.kept or choice.speed <= 0.0:
+            return standing  # no move keeps clearer than standing
+        target = here + max(choice.speed * 2.0, p.lookahead) * np.array(
+            [math.cos(choice.heading), math.sin(choice.heading)])
+        tx, ty = float(target[0]), float(target[1])
+        v, omega = command_toward(pose[0], pose[1], pose[2], (tx, ty), choice.speed,
+                                  p.heading_gain, p.max_omega)
+        culprit = walkers[choice.mover].id if choice.mover is not None else None
+        return Decision(v, omega, (tx, ty), "a", "give_way", culprit, "dynamic", choice.speed)
+
     def walked_into(self, pose: tuple[float, float, float], obstacles: list[Obstacle]) -> bool:
         """Whether a walker in the window, or one remembered out of view, would touch the
         robot standing where it is within ``safety_horizon``: the speed and safety
@@ -1018,9 +1044,15 @@ class Planner:
         stage's clearance growth. A recovery step that turns the robot in place, backs
         it up or waits ends on it, and so does a hold at a spot aside where the robot
         stands. Off with the stage (``speed_check``)."""
-        p = self.p
-        if not p.speed_check:
-            return False
+        walkers = self._walkers_at(pose, obstacles)
+        return bool(walkers) and self._walks_into(pose, walkers)
+
+    def _walkers_at(self, pose: tuple[float, float, float],
+                    obstacles: list[Obstacle]) -> list[Obstacle]:
+        """``walked_into``'s walkers: the movers in the window and those remembered out
+        of view, none on a cell the map holds; none with the stage off (``speed_check``)."""
+        if not self.p.speed_check:
+            return []
         walkers = [o for o in obstacles if self._moving(o) and self._in_window(o, pose)]
         walkers += [o for o, _ in self.unseen]
         if self.costmap is not None:
@@ -1029,8 +1061,9 @@ class Planner:
             # cell the map holds.
             walkers = [o for o in walkers if len(self.costmap.lethal_near(
                 np.asarray(o.position, dtype=np.float64), ON_THE_MAP)) == 0]
-        if not walkers:
-            return False
+        return walkers
+
+    def _walks_into(self, pose: tuple[float, float, float], walkers: list[Obstacle]) -> bool:
         robot, group, _, _ = self._safety_inputs(pose, np.asarray(pose[:2]), walkers, None)
         at_rest = dataclasses.replace(robot, speed=0.0)
         plain = dataclasses.replace(self.safety_settings, growth=0.0)

@@ -337,6 +337,36 @@ def test_a_goal_inside_an_obstacle_ends_in_unreachable_and_the_robot_stops() -> 
     assert p.step(POSE, [], t + 1.0).action == "unreachable"  # for good
 
 
+@pytest.mark.parametrize(("walker", "moves"), [
+    (mover(7, 2.0, 4.3, 0.0, -0.6), True),   # from the left, at the robot in about 1.3 s
+    (mover(7, 3.5, 3.05, -0.3, 0.0), True),  # head-on, at the robot in about 3.3 s
+    (mover(7, 3.5, 4.5, 0.3, 0.0), False),   # walking away, 1.5 m to the side
+])
+def test_a_robot_that_gave_up_steps_out_of_a_walker_s_way_and_else_stands(
+        walker: Obstacle, moves: bool) -> None:
+    """Once the goal is unreachable the robot stands for good, but not in the way of a
+    walker that would walk into it: it heads off the walker's line."""
+    p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    wall = [(8.02, 1.0, 8.5, 5.0)]  # no way to the goal (as above)
+    t, d = 0.0, None
+    while d is None or d.action != "unreachable":
+        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
+        t = round(t + 0.1, 6)
+        assert t < 120.0
+    d = p.step(POSE, [walker], t, scan_of(POSE, boxes=wall))
+    if not moves:
+        assert (d.action, d.v, d.omega) == ("unreachable", 0.0, 0.0)
+        return
+    assert (d.action, d.obstacle) == ("give_way", walker.id)
+    assert d.v > 0.0 or d.omega != 0.0
+    # The way it steps clears the walker's line by more than the two radii.
+    way = np.array(d.target) - np.array(POSE[:2])
+    line = np.array(walker.velocity) / math.hypot(*walker.velocity)
+    rel = np.array(d.target) - np.array(walker.position)
+    off = abs(float(line[0] * rel[1] - line[1] * rel[0]))
+    assert off > p.p.robot_radius + walker.radius, (way, off)
+
+
 def test_while_a_way_is_known_recovery_goes_on_and_never_gives_up() -> None:
     p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
     actions = {p.step(POSE, [], round(k * 0.1, 6)).action for k in range(600)}
