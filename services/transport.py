@@ -561,7 +561,10 @@ class ZenohBus(Bus):
     async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
         def ask() -> list[tuple[str, bytes]]:
             replies = []
-            for reply in self._session.get(selector, timeout=timeout):
+            # No consolidation: Zenoh's default keeps only the last reply per key, and a
+            # history is many replies on one key.
+            for reply in self._session.get(selector, timeout=timeout,
+                                           consolidation=zenoh.ConsolidationMode.NONE):
                 if reply.ok is not None:
                     replies.append((str(reply.ok.key_expr), reply.ok.payload.to_bytes()))
             return replies
