@@ -1,23 +1,39 @@
-"""``ZenohBus.latest`` over real Zenoh sessions: the newest sample of a key is held by the
-middleware's ring channel and taken when the consumer looks, without a callback into
-the receiving process's loop."""
+"""``ZenohBus`` over real Zenoh sessions: ``latest`` (the newest sample of a key is held
+by the middleware's ring channel and taken when the consumer looks, without a callback
+into the receiving process's loop) and ``query`` (every reply comes back, in order,
+though all are on one key, as the planner's event history is)."""
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import time
+from collections.abc import Iterator
+
+import pytest
 
 from zenav.launch import free_port_block
 from zenav.services.transport import TransportConfig, ZenohBus
 
+pytestmark = pytest.mark.integration
+
+
+@contextlib.contextmanager
+def linked(loop: asyncio.AbstractEventLoop) -> Iterator[tuple[ZenohBus, ZenohBus]]:
+    """Two sessions on this machine, the first listening and the second connecting."""
+    endpoint = f"tcp/127.0.0.1:{free_port_block(1)}"
+    listening = ZenohBus(TransportConfig(listen=[endpoint]), loop)
+    connecting = ZenohBus(TransportConfig(connect=[endpoint]), loop)
+    try:
+        yield listening, connecting
+    finally:
+        connecting.close()
+        listening.close()
+
 
 def test_the_newest_sample_waits_in_zenoh_until_taken():
     async def scenario() -> None:
-        loop = asyncio.get_running_loop()
-        endpoint = f"tcp/127.0.0.1:{free_port_block(1)}"
-        receiver = ZenohBus(TransportConfig(listen=[endpoint]), loop)
-        sender = ZenohBus(TransportConfig(connect=[endpoint]), loop)
-        try:
+        with linked(asyncio.get_running_loop()) as (receiver, sender):
             newest = receiver.latest("zenav/robot0/odom")
             marker = receiver.latest("zenav/robot0/marker")
             pub = sender.publisher("zenav/robot0/odom")
@@ -48,8 +64,21 @@ def test_the_newest_sample_waits_in_zenoh_until_taken():
             assert got == ("zenav/robot0/marker", b"after")
             assert newest.take() == ("zenav/robot0/odom", b"3")  # 1 and 2 were overwritten
             assert newest.take() is None
-        finally:
-            sender.close()
-            receiver.close()
+
+    asyncio.run(scenario())
+
+
+def test_a_query_returns_every_reply_on_one_key():
+    key = "zenav/robot0/planner/history"
+    history = [bytes([i]) for i in range(5)]
+
+    async def scenario() -> None:
+        with linked(asyncio.get_running_loop()) as (answering, asking):
+            answering.declare_queryable(key, lambda: list(history))
+            replies: list[tuple[str, bytes]] = []
+            deadline = time.monotonic() + 20
+            while not replies and time.monotonic() < deadline:  # until the link is up
+                replies = await asking.query(key, timeout=1.0)
+            assert replies == [(key, payload) for payload in history]
 
     asyncio.run(scenario())
