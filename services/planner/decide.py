@@ -635,6 +635,12 @@ class Planner:
                                    growth=self.safety_settings.growth * p.drive_on_growth)
         return safety.keeps_clear(robot, (heading, p.cruise_speed), group, blocked, wary)
 
+    def _toward_choice(self, robot: Vec, choice: safety.Choice) -> Vec:
+        """The point the robot steers for to drive the safety stage's ``choice``: along its
+        heading, as far as two seconds at its speed and at least the look-ahead."""
+        reach = max(choice.speed * 2.0, self.p.lookahead)
+        return robot + reach * np.array([math.cos(choice.heading), math.sin(choice.heading)])
+
     def _carrot(self, robot: Vec, path_target: Vec) -> Vec:
         """The point on the global path the safety stage measures progress to: as far
         along as the top speed reaches within the horizon, past the look-ahead point."""
@@ -889,9 +895,7 @@ class Planner:
                 culprit = walkers[choice.mover] if choice.mover is not None else None
                 ahead = math.atan2(target[1] - robot[1], target[0] - robot[0])
                 turned = abs(wrap_angle(choice.heading - ahead))
-                reach = max(choice.speed * 2.0, p.lookahead)
-                target = robot + reach * np.array([math.cos(choice.heading),
-                                                   math.sin(choice.heading)])
+                target = self._toward_choice(robot, choice)
                 if turned > math.radians(p.safety_fan_deg) / 2:
                     action = "morphin"  # step aside
                 elif choice.speed > speed:
@@ -1029,8 +1033,7 @@ class Planner:
                                self.safety_settings)
         if choice.kept or choice.speed <= 0.0:
             return standing  # no move keeps clearer than standing
-        target = here + max(choice.speed * 2.0, p.lookahead) * np.array(
-            [math.cos(choice.heading), math.sin(choice.heading)])
+        target = self._toward_choice(here, choice)
         tx, ty = float(target[0]), float(target[1])
         v, omega = command_toward(pose[0], pose[1], pose[2], (tx, ty), choice.speed,
                                   p.heading_gain, p.max_omega)
