@@ -996,6 +996,11 @@ class Planner:
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(decision, pose, scan)
+            if decision.refused and self._blocked_within_window(robot, stamp):
+                # The stop zone refuses the way along a path that runs into what the map
+                # has come to hold since it was planned (a wall's end seen late): the
+                # local layer saw no threat on it, so it is planned again on the map.
+                self.replan_asked = "blocked within the window"
             waiting = (decision.action in ("stop", "slow", "give_way")
                        and decision.kind == "dynamic")
             # Walled in: the goal is cut off by walls seen (the wall memory), so gains
@@ -1373,6 +1378,17 @@ class Planner:
         if beyond is not None:
             return "blocked beyond the window"
         return None
+
+    def _blocked_within_window(self, robot: Vec, stamp: float) -> bool:
+        """Whether the global path runs into what the map holds within the window, off
+        a detour, with a replan due (at most once per ``replan_period``)."""
+        p = self.p
+        if (self.costmap is None or self.path is None or self.lengths is None
+                or self.detour is not None or stamp - self.last_replan < p.replan_period):
+            return False
+        s0, _ = project(self.path, robot, self.lengths)
+        at = first_blocked(self.costmap, self.path, s0, p.map_resolution, self.lengths)
+        return at is not None and at < s0 + p.window_radius
 
     def update_path(self, robot: Vec, stamp: float) -> None:
         """Plan the global path on the map when it is needed (see ``replan_reason``)."""

@@ -556,3 +556,21 @@ def test_off_the_path_the_rejoin_point_must_be_clear_of_the_map_too() -> None:
     assert s_target > s_robot + p.p.lookahead  # beyond the look-ahead point
     beyond = point_at(p.path, s_target + p.p.map_resolution, p.lengths)
     assert not p._chord_clear(robot, beyond)  # the farthest such point
+
+
+def test_a_path_the_stop_zone_refuses_where_the_map_blocks_it_is_planned_again() -> None:
+    """A path planned before the map held a wall's end (nav-room-door-behind) runs into
+    it within the window, where the local layer has no track to answer: the stop zone
+    refuses the way, and the path is planned again round what the map holds. Before, the
+    refusal came and went as the robot turned, and it crept along the wall until the
+    no-progress watch ran out (14 s)."""
+    wall = [(2.25, 2.6, 2.45, 4.5)]  # its end just right of the straight line
+    p = planner()
+    for t in (0.0, 2.0):
+        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
+    assert d.refused and p.plan_count == 1  # still the straight line of the start
+    assert p.replan_asked == "blocked within the window"
+    d = p.step(POSE, [], 2.1, scan_of(POSE, boxes=wall))
+    assert p.plan is not None and p.plan.found and p.plan.reason == "blocked within the window"
+    assert p.costmap is not None
+    assert not p.costmap.blocked_at(p.path[1:], outside=True).any()
