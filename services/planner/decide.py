@@ -1354,8 +1354,9 @@ class Planner:
     def replan_reason(self, robot: Vec, stamp: float) -> str | None:
         """Why the global path must be planned again now, or None. Obstacles in the
         window are the local layer's; the path is planned again when the local layer
-        asks (no way round), when the robot has left the path (after a detour), or when
-        the map blocks the path beyond the window."""
+        asks (no way round), when the stop zone refuses a way the map blocks within the
+        window (``step``), when the robot has left the path (after a detour), or when the
+        map blocks the path beyond the window."""
         p = self.p
         if self.replan_asked is not None:
             return self.replan_asked

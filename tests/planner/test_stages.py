@@ -572,5 +572,5 @@ def test_a_path_the_stop_zone_refuses_where_the_map_blocks_it_is_planned_again()
     assert p.replan_asked == "blocked within the window"
     d = p.step(POSE, [], 2.1, scan_of(POSE, boxes=wall))
     assert p.plan is not None and p.plan.found and p.plan.reason == "blocked within the window"
-    assert p.costmap is not None
+    assert p.costmap is not None and p.path is not None
     assert not p.costmap.blocked_at(p.path[1:], outside=True).any()
