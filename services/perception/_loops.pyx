@@ -10,7 +10,7 @@ meaning and the equations (Eq. 3's threshold comes in as an array from
 
 import numpy as np
 
-from libc.math cimport INFINITY, atan2, hypot, rint, sqrt
+from libc.math cimport INFINITY, atan2, fabs, hypot, rint, sqrt
 from libc.stdlib cimport calloc, free
 
 include "../_angles.pxi"
@@ -28,6 +28,8 @@ cdef inline bint free_at(double px, double py, double x, double y, double headin
     cdef double distance = hypot(dx, dy)
     cdef double bearing = wrap_angle(atan2(dy, dx) - heading)
     cdef double beam = rint((bearing - angle_min) / angle_increment)
+    if beam < 0:  # a full-circle scan started past -pi (perception's seam turn)
+        beam += rint(2.0 * M_PI / fabs(angle_increment))
     if not (1 <= beam <= n - 2):
         return False
     b = <Py_ssize_t>beam

@@ -15,7 +15,10 @@ Conventions
   the heading; with alpha counter-clockwise the same point is
   ``(x_R + rho cos(theta_R + alpha), y_R + rho sin(theta_R + alpha))``.
 * A reading that is not finite, ``< range_min`` or ``>= range_max`` is "no return".
-* Scans up to 360 degrees; a cluster never wraps from the last beam to the first.
+* Scans up to 360 degrees. A full-circle scan has a seam (straight behind, in the usual
+  layout) where the last beam meets the first; an obstacle across it would be cut in two.
+  ``seam_shift`` and ``rotate_scan`` let perception start such a scan at a break between
+  clusters instead (``perceive.py``); within one scan a cluster never wraps.
 
 Decisions on points the paper leaves open
 -----------------------------------------
@@ -269,6 +272,49 @@ def scan_window(
     alpha = (angle_min + idx * angle_increment).astype(np.float64, copy=False)
     px, py = to_global(pose, rho, alpha)  # Eq. 1
     return Window(r, valid, idx, rho, alpha, px, py)
+
+
+def full_circle(n_beams: int, angle_increment: float) -> int:
+    """The beams of one turn (``round(2 pi / |increment|)``) when the scan's ``n_beams``
+    close a full circle (the last may repeat the first's direction, as a 360-degree scan
+    from -pi to pi does); 0 for a scan that does not."""
+    step = abs(angle_increment)
+    if step <= 0.0:
+        return 0
+    period = round(2.0 * math.pi / step)
+    if n_beams < period or abs(period * step - 2.0 * math.pi) > 1e-6:
+        return 0
+    return period
+
+
+def seam_shift(clusters: Clusters, window: Window, angle_increment: float,
+               params: PerceptionParams) -> int | None:
+    """For a full-circle scan whose seam cuts a cluster in two, the beam to start the scan
+    at instead: the middle of the widest break between two clusters that follow each
+    other (Eq. 3 did not join them), so that no cluster touches the new seam unless the
+    break is a single beam wide. None when the scan is not a full circle, the seam already
+    lies at a break (the last window point and the first, consecutive across the seam, do
+    not join by Eq. 3), or there is no break to move it to (one ring all round)."""
+    period = full_circle(window.ranges.shape[0], angle_increment)
+    if not period or len(clusters) < 2 or window.beams.size < 2:
+        return None
+    gap = math.hypot(float(window.x[0] - window.x[-1]), float(window.y[0] - window.y[-1]))
+    if gap > float(join_threshold(window.rho[0], angle_increment, params)):
+        return None
+    beams = clusters.beams
+    widest = int(np.argmax(beams[1:, 0] - beams[:-1, 1]))
+    shift = int(beams[widest, 1] + beams[widest + 1, 0] + 1) // 2
+    return shift if shift < period else None
+
+
+def rotate_scan(ranges: FloatArray, angle_min: float, angle_increment: float,
+                shift: int) -> tuple[FloatArray, float]:
+    """One turn of a full-circle scan (``full_circle`` beams; a repeated last direction
+    is dropped) started at beam ``shift``: its ranges and the new ``angle_min``. Beam
+    angles then run past pi, which Eq. 1 takes as they are."""
+    period = full_circle(ranges.shape[0], angle_increment)
+    turned = np.roll(np.ascontiguousarray(ranges[:period], dtype=np.float64), -shift)
+    return turned, angle_min + shift * angle_increment
 
 
 def cluster_scan(

@@ -9,6 +9,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from zenav.schemas.messages import LaserScan
+
 from zenav.services.perception.clustering import (
     EDGE_CLIPPED,
     EDGE_FREE,
@@ -16,10 +18,16 @@ from zenav.services.perception.clustering import (
     Clusters,
     box_area,
     cluster_scan,
+    cluster_window,
+    full_circle,
     grid_index,
     join_threshold,
+    rotate_scan,
+    scan_window,
+    seam_shift,
 )
 from zenav.services.perception.params import PerceptionParams
+from zenav.services.perception.perceive import Perceiver
 
 HALF_DEG = math.radians(0.5)
 PAPER = PerceptionParams.paper()  # Eq. 3 alone, single beams kept
@@ -264,3 +272,107 @@ def test_chain_invariants(ranges: list[float], pose: tuple[float, float, float])
     # Eq. 5 + Eq. 1: the centre lies at mean_rho from the robot
     d = np.hypot(c.centre[:, 0] - pose[0], c.centre[:, 1] - pose[1])
     np.testing.assert_allclose(d, c.mean_rho, atol=1e-9)
+
+
+# --- the seam of a full-circle scan ------------------------------------------------------
+
+
+def disc_scan(centre: tuple[float, float], radius: float, pose: tuple[float, float, float],
+              n: int = 721) -> np.ndarray:
+    """A 360-degree scan (beam 0 and beam n - 1 both straight behind, as the simulator's)
+    of one disc, 8 m (no return) elsewhere."""
+    alpha = -math.pi + HALF_DEG * np.arange(n) + pose[2]
+    ox, oy = centre[0] - pose[0], centre[1] - pose[1]
+    b = np.cos(alpha) * ox + np.sin(alpha) * oy
+    d = b * b - (ox * ox + oy * oy - radius * radius)
+    near = b - np.sqrt(np.maximum(d, 0.0))
+    return np.where((d >= 0) & (near > 0), near, 8.0)
+
+
+def test_full_circle_counts_one_turn_and_only_full_circles() -> None:
+    assert full_circle(721, HALF_DEG) == 720  # -pi..pi, the last beam repeats the first
+    assert full_circle(720, HALF_DEG) == 720
+    assert full_circle(720, -HALF_DEG) == 720
+    assert full_circle(361, HALF_DEG) == 0  # the paper's 180 degrees
+    assert full_circle(719, HALF_DEG) == 0
+    assert full_circle(100, math.radians(0.7)) == 0  # 2 pi is no whole number of steps
+
+
+def test_a_disc_straight_behind_is_cut_by_the_seam_of_the_scan_as_it_comes() -> None:
+    pose = (0.0, 0.0, 0.0)
+    c = cluster_scan(disc_scan((-2.0, 0.0), 0.3, pose), -math.pi, HALF_DEG, 0.05, 8.0, pose,
+                     PerceptionParams())
+    assert len(c) == 2  # what perception turns the scan for
+    assert c.beams[0, 0] == 0 and c.beams[1, 1] == 720
+
+
+def test_the_turned_scan_starts_in_the_widest_break_and_keeps_every_direction() -> None:
+    pose = (1.0, 2.0, 0.3)
+    # straight behind the robot, across the seam, and one to its left
+    behind_at = (1.0 - 2.0 * math.cos(0.3), 2.0 - 2.0 * math.sin(0.3))
+    r = np.minimum(disc_scan(behind_at, 0.3, pose), disc_scan((1.0, 4.0), 0.2, pose))
+    params = PerceptionParams()
+    window = scan_window(r, -math.pi, HALF_DEG, 0.05, 8.0, pose, params.window_radius)
+    c = cluster_window(window, HALF_DEG, pose, params)
+    assert len(c) == 3  # the disc behind in two, the one to the left
+    shift = seam_shift(c, window, HALF_DEG, params)
+    assert shift is not None
+    # The widest break between clusters that follow each other, and its middle beam.
+    gaps = c.beams[1:, 0] - c.beams[:-1, 1]
+    i = int(np.argmax(gaps))
+    assert c.beams[i, 1] < shift < c.beams[i + 1, 0]
+    turned, angle_min = rotate_scan(window.ranges, -math.pi, HALF_DEG, shift)
+    assert turned.shape == (720,) and angle_min == -math.pi + shift * HALF_DEG
+    # Beam k of the turned scan looks where beam (k + shift) mod 720 looked.
+    k = np.arange(720)
+    assert np.array_equal(turned, window.ranges[(k + shift) % 720])
+    again = cluster_scan(turned, angle_min, HALF_DEG, 0.05, 8.0, pose, params)
+    assert len(again) == 2
+    # the whole disc behind: its chord centre within radius^2 / distance of its centre
+    behind = int(np.argmin(np.hypot(*(again.chord_centre - behind_at).T)))
+    # (not a half: the sliver either side of the seam has its chord centre 0.14 m aside)
+    assert np.hypot(*(again.chord_centre[behind] - behind_at)) < 0.1
+    assert again.radius[behind] == pytest.approx(0.3, abs=0.03)
+    assert again.edge_start[behind] == EDGE_FREE and again.edge_end[behind] == EDGE_FREE
+
+
+def test_the_seam_is_left_where_it_lies_at_a_break() -> None:
+    pose = (0.0, 0.0, 0.0)
+    params = PerceptionParams()
+    r = np.minimum(disc_scan((0.0, -1.5), 0.3, pose), disc_scan((0.0, 1.5), 0.3, pose))
+    window = scan_window(r, -math.pi, HALF_DEG, 0.05, 8.0, pose, params.window_radius)
+    assert seam_shift(cluster_window(window, HALF_DEG, pose, params), window, HALF_DEG,
+                      params) is None
+    # nor is a scan that is no full circle turned
+    half = scan_window(disc_scan((-2.0, 0.0), 0.3, pose)[:361], -math.pi, HALF_DEG, 0.05,
+                       8.0, pose, params.window_radius)
+    assert seam_shift(cluster_window(half, HALF_DEG, pose, params), half, HALF_DEG,
+                      params) is None
+
+
+def test_perception_sees_what_stands_or_walks_straight_behind_whole() -> None:
+    # The robot drives on at 1 m/s with a disc straight behind it, across the seam of
+    # every scan: a post it leaves behind, then a walker that follows it 2 m back.
+    for walks in (False, True):
+        perceiver = Perceiver(PerceptionParams())
+        moved = []
+        for k in range(12):
+            pose = (0.1 * k, 0.0, 0.0)
+            disc = (-2.0 + (0.1 * k if walks else 0.0), 0.0)
+            scan = LaserScan(seq=k, frame="laser", stamp=0.1 * k, angle_min=-math.pi,
+                             angle_max=math.pi, angle_increment=HALF_DEG, range_min=0.05,
+                             range_max=8.0, ranges=disc_scan(disc, 0.3, pose).tolist())
+            c = perceiver.process(scan, pose)
+            assert len(c) == 1
+            assert c.radius[0] == pytest.approx(0.3, abs=0.05)
+            assert abs(c.chord_centre[0, 1]) < 1e-6
+            assert disc[0] < c.chord_centre[0, 0] < disc[0] + 0.3
+            assert c.moved is not None
+            moved.append(float(c.moved[0]))
+        # Every scan is turned (the disc lies across its seam); the motion cue compares
+        # the turned scans: the post never moved, the walker has from the first
+        # comparison (0.2 s) on.
+        if walks:
+            assert min(moved[2:]) > 0.5
+        else:
+            assert max(moved) == 0.0
