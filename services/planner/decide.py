@@ -816,7 +816,7 @@ class Planner:
             threats.append(dataclasses.replace(base, letter="e", threat=True))
         if p.threats_per_cycle == "one" and threats:  # Algorithm 1: first in O_chain, break
             threats = [first_in_scan_order(threats, robot, pose[2])]
-        if self.hold is None and self._start_hold(robot, threats, in_window, stamp):
+        if self.hold is None and self._start_hold(robot, target, threats, in_window, stamp):
             aside = self.hold_aside(pose, obstacles, stamp)
             if aside is not None:
                 self.detour = None
@@ -1111,12 +1111,14 @@ class Planner:
 
     # -- stage: giving way in a corridor -----------------------------------------------
 
-    def _start_hold(self, robot: Vec, threats: list[Assessment], in_window: list[Obstacle],
-                    stamp: float) -> bool:
+    def _start_hold(self, robot: Vec, target: Vec, threats: list[Assessment],
+                    in_window: list[Obstacle], stamp: float) -> bool:
         """Beyond the paper: when the one mover in the window comes head-on and threatens,
-        and the map holds walls on both sides of the robot (``give_way.hemmed_in``), pick
-        a spot aside (``give_way.spot_aside``: on the side of the mover's way the robot is
-        on, else the other) and hold it (``hold_aside``); whether one was found."""
+        or comes up from behind on the robot's line faster than the robot can go
+        (``_overtaking``: no outrunning it), and the map holds walls on both sides of
+        the robot (``give_way.hemmed_in``), pick a spot aside (``give_way.spot_aside``:
+        on the side of the mover's way the robot is on, else the other) and hold it
+        (``hold_aside``); whether one was found. ``target``: where the robot is heading."""
         p = self.p
         if not (p.give_way and p.use_map) or self.costmap is None:
             return False
@@ -1124,13 +1126,15 @@ class Planner:
         if len(movers) != 1:
             return False
         mover = movers[0]
-        threat = next((a for a in threats if a.obstacle.id == mover.id), None)
-        if threat is None:
-            return False
         velocity = np.asarray(mover.velocity, dtype=np.float64)
         speed = float(np.hypot(*velocity))
-        if float(np.asarray(threat.direction) @ velocity) > p.head_on_cos * speed:
-            return False  # not head-on
+        overtaking = self._overtaking(robot, target, mover)
+        if not overtaking:
+            threat = next((a for a in threats if a.obstacle.id == mover.id), None)
+            if threat is None:
+                return False
+            if float(np.asarray(threat.direction) @ velocity) > p.head_on_cos * speed:
+                return False  # not head-on
         axis = corridor_axis(self.costmap.lethal_near(robot, 2.0 * p.give_way_reach),
                              p.map_resolution)
         if axis is None or abs(float(axis @ velocity)) < -p.head_on_cos * speed:
@@ -1143,28 +1147,57 @@ class Planner:
         position = np.asarray(mover.position, dtype=np.float64)
         near = 1 if offsets(robot[None, :], position, way)[0] >= 0.0 else -1
         for side in (near, -near):
-            spot = self._spot_aside(robot, position, way, speed, radius, side)
+            spot = self._spot_aside(robot, position, way, speed, radius, side, overtaking)
             if spot is not None:
                 self.hold = Hold(
                     spot=(float(spot[0]), float(spot[1])), side=side, radius=radius,
                     mover=mover.id, way=(float(way[0]), float(way[1])),
                     until=stamp + p.give_way_limit, position=mover.position,
-                    velocity=mover.velocity, at=stamp, seen=stamp, moving=stamp)
+                    velocity=mover.velocity, at=stamp, seen=stamp, moving=stamp,
+                    overtaking=overtaking)
                 return True
         return False
 
+    def _overtaking(self, robot: Vec, target: Vec, mover: Obstacle) -> bool:
+        """Whether ``mover`` comes up from behind the robot going its way (toward
+        ``target``, within ``same_way_cos``) faster than ``max_speed``, on a line that
+        passes the robot within the clearance (robot and mover radii, a track of part of
+        the mover taken as big as the robot, and the safety margin), and will be abreast
+        of it within ``horizon`` s even with the robot at its top speed."""
+        p = self.p
+        velocity = np.asarray(mover.velocity, dtype=np.float64)
+        speed = float(np.hypot(*velocity))
+        ahead = target - robot
+        length = float(np.hypot(*ahead))
+        if speed <= p.max_speed or length < 1e-9:
+            return False
+        way = velocity / speed
+        if float(ahead @ way) < p.same_way_cos * length:
+            return False  # not the robot's way
+        clearance = p.robot_radius + max(mover.radius, p.robot_radius) + p.safety_margin
+        rel = robot - np.asarray(mover.position, dtype=np.float64)
+        behind = float(rel @ way)  # how far the robot is ahead of the mover along its way
+        if behind <= 0.0 or abs(float(way[0] * rel[1] - way[1] * rel[0])) >= clearance:
+            return False  # beside or ahead of the robot already, or passing it clear
+        return (behind - clearance) / (speed - p.max_speed) <= p.horizon
+
     def _spot_aside(self, robot: Vec, position: Vec, way: Vec, speed: float, radius: float,
-                    side: int) -> Vec | None:
+                    side: int, overtaking: bool = False) -> Vec | None:
         """``give_way.spot_aside`` with the planner's map and parameters: a spot the mover
-        passes with the whole safety margin to spare where there is one, else half."""
+        passes with the whole safety margin to spare where there is one, else half,
+        reached at ``cruise_speed`` after a square turn; from a mover ``overtaking``,
+        which comes faster than the robot can go, a spot ahead within 45 degrees, reached
+        at ``max_speed`` after that turn."""
         assert self.costmap is not None
         p = self.p
+        turn = math.pi / 4 if overtaking else math.pi / 2
         for margin in (p.safety_margin, p.safety_margin / 2):
             spot = spot_aside(
                 robot, position, way, speed, p.robot_radius + radius + margin, side,
                 self.costmap.blocked_at, lambda a, b: self._disc_clear(self._leg(a, b)),
-                p.give_way_reach, p.map_resolution / 2, p.cruise_speed,
-                lead=(math.pi / 2) / p.max_omega)
+                p.give_way_reach, p.map_resolution / 2,
+                p.max_speed if overtaking else p.cruise_speed, lead=turn / p.max_omega,
+                ahead=overtaking)
             if spot is not None:
                 return spot
         return None
@@ -1221,32 +1254,48 @@ class Planner:
         held = np.asarray(hold.spot, dtype=np.float64)[None, :]
         if offsets(held, position, way)[0] * hold.side < p.robot_radius + hold.radius:
             better = self._spot_aside(robot, position, way, math.hypot(*hold.velocity),
-                                      hold.radius, hold.side)
+                                      hold.radius, hold.side, hold.overtaking)
             if better is not None:
                 hold.spot = (float(better[0]), float(better[1]))
         spot = np.asarray(hold.spot, dtype=np.float64)
         hold.reached = hold.reached or math.dist(pose[:2], hold.spot) <= p.subtarget_reached / 3
-        if not hold.reached:
+        # The spot's lane: square to it along the mover's line, and on the robot's way.
+        go = np.asarray(hold.lane, dtype=np.float64)
+        on_lane = spot + float((robot - spot) @ way) * way
+        ahead = on_lane + p.lookahead * go
+        assert self.costmap is not None  # a hold starts only on a map
+        lane_free = not self.costmap.blocked_at(
+            path_points(on_lane, go, p.lookahead, p.map_resolution / 2)).any()
+        if hold.overtaking:
+            # The spot lies ahead: swerve into its lane and go on along it, at top speed
+            # until in the lane (to half a map cell), then at cruise speed; where the
+            # lane is blocked, stand, facing the mover.
+            if lane_free:
+                short = float(offsets(np.vstack([spot, robot]), position, way) @ [1.0, -1.0])
+                target = (float(ahead[0]), float(ahead[1]))
+                into = short * hold.side > p.map_resolution / 2
+                speed = p.max_speed if into else p.cruise_speed
+            else:
+                target, speed = hold.position, 0.0
+            drive = command_toward
+        elif not hold.reached:
             target, speed = hold.spot, p.cruise_speed
             bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
             drive = backing_toward if math.cos(bearing - pose[2]) < 0.0 else command_toward
         else:
             # Keep to this side of the mover's line and go on along it while the map
             # leaves the lane free a look-ahead on; else stand there, facing the mover.
-            on_lane = spot + float((robot - spot) @ way) * way
-            ahead = on_lane - p.lookahead * way
-            lane = path_points(on_lane, -way, p.lookahead, p.map_resolution / 2)
-            assert self.costmap is not None  # a hold starts only on a map
-            if not self.costmap.blocked_at(lane).any():
+            if lane_free:
                 target, speed = (float(ahead[0]), float(ahead[1])), p.cruise_speed
-                along = math.atan2(-way[1], -way[0])
+                along = math.atan2(go[1], go[0])
                 if abs(wrap_angle(along - pose[2])) > math.radians(p.safety_fan_deg):
                     speed = 0.0  # square to the lane first: turning on the move drifts
             else:
                 target, speed = hold.position, 0.0
             drive = command_toward
         v, omega = drive(pose[0], pose[1], pose[2], target, speed, p.heading_gain, p.max_omega)
-        return Decision(v, omega, target, "f", "give_way", hold.mover, "dynamic", speed)
+        letter: ScenarioLetter = "g" if hold.overtaking else "f"
+        return Decision(v, omega, target, letter, "give_way", hold.mover, "dynamic", speed)
 
     # -- the movers out of view --------------------------------------------------------
 

@@ -3,8 +3,10 @@
 Beyond the paper. The paper answers a head-on mover (f) with a Morphin detour round it.
 Between two walls there is no way round: the detours turn back along the corridor, the
 robot drives away from the mover at its own (lower) speed, turns its back on it and
-loses it from the 180-degree laser, and the mover walks into it. A person in a corridor
-steps aside and lets it by. This module finds where:
+loses it from the 180-degree laser, and the mover walks into it. A mover that comes up
+from behind faster than the robot can go (seen with a wider laser) is the same: the
+robot cannot outrun it, and no detour is planned for a mover behind. A person in a
+corridor steps aside and lets it by. This module finds where:
 
 - :func:`hemmed_in`: the map holds something within reach on both sides of the robot,
   square to the mover's way (a corridor, a doorway): the only case where the robot
@@ -56,6 +58,14 @@ class Hold:
     seen: float  # stamp it was last seen
     moving: float  # stamp it was last seen moving
     reached: bool = False  # the robot has been at the spot: it keeps to that side now
+    overtaking: bool = False  # the mover comes from behind, the robot's way (else head-on)
+
+    @property
+    def lane(self) -> tuple[float, float]:
+        """The way the robot goes on along its lane: against the mover's way for one
+        coming head-on, with it for one overtaking."""
+        sign = 1.0 if self.overtaking else -1.0
+        return (sign * self.way[0], sign * self.way[1])
 
     def predicted(self, stamp: float) -> Vec:
         """Where the mover is now: from ``position``, along its way at the speed it was
@@ -110,13 +120,16 @@ def offsets(points: Vec, mover: Vec, way: Vec) -> Vec:
 
 def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
                side: int, blocked_at: BlockedAt, leg_clear: Callable[[Vec, Vec], bool],
-               reach: float, step: float, robot_speed: float, lead: float) -> Vec | None:
+               reach: float, step: float, robot_speed: float, lead: float,
+               ahead: bool = False) -> Vec | None:
     """The nearest point within ``reach`` m of ``robot`` (on a ``step`` m grid) that is
     free on the map, at least ``clearance`` m to ``side`` (+1 left, -1 right) of the
     line the mover walks (through ``mover`` along ``way``, unit, at ``speed``), and
     reached in a straight line (``leg_clear``) at ``robot_speed`` ``lead`` s (time to
     turn) before the mover comes within the clearance of being abreast of it; None if
-    none is, or if the mover does not come toward the robot."""
+    none is, or if the mover does not come toward the robot. ``ahead``: only points at
+    most 45 degrees off ``way`` from the robot (a mover overtaking it: the robot swerves
+    on along its way, with no time for a square turn)."""
     if speed < 1e-9 or robot_speed <= 0.0:
         return None
     if float((robot - mover) @ way) <= clearance:
@@ -130,6 +143,10 @@ def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
     aside = offsets(points, mover, way) * side >= clearance
     along = (points - mover[None, :]) @ way
     ok = aside & ((along - clearance) / speed >= distance / robot_speed + lead)
+    if ahead:
+        rel = points - robot[None, :]
+        forward = rel @ way
+        ok &= forward >= np.abs(way[0] * rel[:, 1] - way[1] * rel[:, 0]) - 1e-9
     if not ok.any():
         return None
     ok[ok] = ~blocked_at(points[ok])
