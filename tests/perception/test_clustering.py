@@ -10,7 +10,6 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from zenav.schemas.messages import LaserScan
-
 from zenav.services.perception.clustering import (
     EDGE_CLIPPED,
     EDGE_FREE,
