@@ -1268,13 +1268,15 @@ class Planner:
             path_points(on_lane, go, p.lookahead, p.map_resolution / 2)).any()
         if hold.overtaking:
             # The spot lies ahead: swerve into its lane and go on along it, at top speed
-            # until in the lane (to half a map cell), then at cruise speed; where the
-            # lane is blocked, stand, facing the mover.
+            # until in the lane (to half a map cell), then at cruise speed. Where the map
+            # blocks the lane, to the spot at top speed, and there stand, facing the mover.
             if lane_free:
                 short = float(offsets(np.vstack([spot, robot]), position, way) @ [1.0, -1.0])
                 target = (float(ahead[0]), float(ahead[1]))
                 into = short * hold.side > p.map_resolution / 2
                 speed = p.max_speed if into else p.cruise_speed
+            elif not hold.reached:
+                target, speed = hold.spot, p.max_speed
             else:
                 target, speed = hold.position, 0.0
             drive = command_toward

@@ -115,6 +115,32 @@ def test_spot_aside_none_when_too_late_too_narrow_or_blocked() -> None:
                                corridor(0.6), always, 1.0, 0.05, 0.2, 1.5) is None
 
 
+def test_spot_aside_ahead_keeps_within_45_degrees_of_the_way() -> None:
+    # A mover overtaking: at (-3, 0) walking +x at 1.2 m/s, the robot at (0, 0.1) in the
+    # same corridor, clearance 0.45. The nearest spot above the line is straight up;
+    # ahead, the robot swerves: the spot lies at least as far along the way as across.
+    robot = np.array([0.0, 0.1])
+    mover, way = np.array([-3.0, 0.0]), np.array([1.0, 0.0])
+    square = give_way.spot_aside(robot, mover, way, 1.2, 0.45, 1, corridor(0.6), always,
+                                 1.0, 0.05, 1.0, 0.0)
+    assert square == pytest.approx([0.0, 0.45])
+    ahead = give_way.spot_aside(robot, mover, way, 1.2, 0.45, 1, corridor(0.6), always,
+                                1.0, 0.05, 1.0, 0.8, ahead=True)
+    assert ahead is not None and ahead[1] >= 0.45 - 1e-9
+    assert ahead[0] - robot[0] >= abs(ahead[1] - robot[1]) - 1e-9
+    assert ahead == pytest.approx([0.35, 0.45])  # the nearest such point on the grid
+    # Too close behind for any spot ahead: none.
+    assert give_way.spot_aside(robot, np.array([-1.0, 0.0]), way, 1.2, 0.45, 1,
+                               corridor(0.6), always, 1.0, 0.05, 1.0, 0.8, ahead=True) is None
+
+
+def test_the_lane_runs_against_a_head_on_mover_and_with_an_overtaking_one() -> None:
+    kw = dict(spot=(0.0, 0.5), side=1, radius=0.2, mover=3, way=(1.0, 0.0), until=60.0,
+              position=(-3.0, 0.0), velocity=(1.2, 0.0), at=0.0, seen=0.0, moving=0.0)
+    assert give_way.Hold(**kw).lane == (-1.0, -0.0)  # type: ignore[arg-type]
+    assert give_way.Hold(**kw, overtaking=True).lane == (1.0, 0.0)  # type: ignore[arg-type]
+
+
 def test_passed_once_behind_by_the_clearance() -> None:
     robot = np.array([0.0, 0.5])
     way = np.array([-1.0, 0.0])
@@ -209,3 +235,67 @@ def test_giving_way_can_be_turned_off() -> None:
     t = map_walls(p, pose, 2.0)
     p.step(pose, [walker(6.8)], t, scan_of(pose, boxes=WALLS, discs=[(6.8, 3.0, 0.2)]))
     assert p.hold is None
+
+
+# -- a mover overtaking in a corridor ----------------------------------------------------
+
+
+WIDE = [(0.0, 1.4, 14.0, 1.6), (0.0, 4.4, 14.0, 4.6)]  # a 2.8 m corridor along y = 3
+
+
+def overtaker(x: float, y: float = 3.0, speed: float = 0.6) -> Obstacle:
+    return Obstacle(8, "dynamic", (x, y), (speed, 0.0), 0.2, (0, 0, 0, 0))
+
+
+def map_wide(p: Planner, pose: tuple[float, float, float], until: float) -> float:
+    """Scans of the empty wide corridor, all round, every 0.1 s up to ``until``."""
+    t = 0.0
+    while t < until:
+        p.step(pose, [], t, scan_of(pose, boxes=WIDE, fov_deg=360.0))
+        t = round(t + 0.1, 1)
+    return t
+
+
+def test_a_walker_overtaking_in_a_corridor_is_given_way_ahead_and_let_by() -> None:
+    # The robot at (5, 3.0) goes +x at up to 0.4 m/s; a walker 1.7 m behind on its line
+    # (in the 2 m window) comes at 0.6 m/s: no outrunning it, and collision prediction keeps only movers
+    # ahead. Between the walls the robot swerves into a lane off the walker's line.
+    # (A 360-degree laser: the 180-degree one would not see the walker.)
+    pose = (5.0, 3.0, 0.0)
+    p = corridor_planner()
+    t = map_wide(p, pose, 2.0)
+    d = p.step(pose, [overtaker(3.3)], t, scan_of(pose, boxes=WIDE, discs=[(3.3, 3.0, 0.2)], fov_deg=360.0))
+    assert (d.action, d.scenario, d.obstacle) == ("give_way", "g", 8)
+    assert p.hold is not None and p.hold.overtaking
+    spot = p.hold.spot
+    clearance = 0.2 + 0.2 + 0.05  # both radii (the robot's for a smaller track) + margin/2
+    assert abs(spot[1] - 3.0) >= clearance - 1e-9  # off the walker's line
+    assert spot[0] - 5.0 >= abs(spot[1] - 3.0) - 1e-9  # ahead, within 45 degrees
+    # It swerves on toward that side at its top speed (no square turn on the spot).
+    assert d.v > 0.0 and d.omega * (spot[1] - 3.0) > 0.0 and d.speed == 0.4
+    # In the lane it goes on at cruise speed while the walker comes by.
+    in_lane = (spot[0], spot[1], 0.0)
+    d = p.step(in_lane, [overtaker(spot[0] - 1.0)], t + 0.1,
+               scan_of(in_lane, boxes=WIDE, discs=[(spot[0] - 1.0, 3.0, 0.2)], fov_deg=360.0))
+    assert (d.action, d.speed) == ("give_way", 0.2) and d.v > 0.0
+    # Once the walker is ahead of the robot by the clearance, the hold ends.
+    d = p.step(in_lane, [overtaker(spot[0] + 0.5)], t + 0.2,
+               scan_of(in_lane, boxes=WIDE, discs=[(spot[0] + 0.5, 3.0, 0.2)], fov_deg=360.0))
+    assert p.hold is None and d.action != "give_way"
+
+
+@pytest.mark.parametrize(("walls", "x", "y", "speed"), [
+    (False, 3.3, 3.0, 0.6),  # in the open: the speed and safety stage answers it
+    (True, 3.3, 3.0, 0.3),  # slower than the robot's top speed: it can keep ahead
+    (True, 3.3, 3.5, 0.6),  # its line passes the robot clear
+    (True, 6.0, 3.0, 0.6),  # ahead of the robot already
+])
+def test_no_hold_for_a_walker_that_is_not_overtaking_in_a_corridor(
+        walls: bool, x: float, y: float, speed: float) -> None:
+    pose = (5.0, 3.0, 0.0)
+    p = corridor_planner()
+    boxes = WIDE if walls else []
+    t = map_wide(p, pose, 2.0) if walls else 0.0
+    d = p.step(pose, [overtaker(x, y, speed)], t,
+               scan_of(pose, boxes=boxes, discs=[(x, y, 0.2)], fov_deg=360.0))
+    assert p.hold is None and d.action != "give_way"
