@@ -258,13 +258,15 @@ def map_wide(p: Planner, pose: tuple[float, float, float], until: float) -> floa
 
 def test_a_walker_overtaking_in_a_corridor_is_given_way_ahead_and_let_by() -> None:
     # The robot at (5, 3.0) goes +x at up to 0.4 m/s; a walker 1.7 m behind on its line
-    # (in the 2 m window) comes at 0.6 m/s: no outrunning it, and collision prediction keeps only movers
-    # ahead. Between the walls the robot swerves into a lane off the walker's line.
+    # (in the 2 m window) comes at 0.6 m/s: no outrunning it, and collision prediction
+    # keeps only movers ahead. Between the walls the robot swerves into a lane off the
+    # walker's line.
     # (A 360-degree laser: the 180-degree one would not see the walker.)
     pose = (5.0, 3.0, 0.0)
     p = corridor_planner()
     t = map_wide(p, pose, 2.0)
-    d = p.step(pose, [overtaker(3.3)], t, scan_of(pose, boxes=WIDE, discs=[(3.3, 3.0, 0.2)], fov_deg=360.0))
+    d = p.step(pose, [overtaker(3.3)], t,
+               scan_of(pose, boxes=WIDE, discs=[(3.3, 3.0, 0.2)], fov_deg=360.0))
     assert (d.action, d.scenario, d.obstacle) == ("give_way", "g", 8)
     assert p.hold is not None and p.hold.overtaking
     spot = p.hold.spot
