@@ -66,7 +66,8 @@ def test_there_is_a_scenario_for_every_class():
     for needed in ("appear", "wall-gap", "dead-end", "corridor-follower", "corridor-head-on",
                    "corridor-sealed-head-on", "hairpin", "slalom", "room-door-behind",
                    "door-two-way", "two-rooms", "s-bend", "doorway-stopper", "start-at-wall",
-                   "corridor-overtaker", "posts", "mover-stops", "facing-away"):
+                   "corridor-overtaker", "blind-overtaker", "posts", "mover-stops",
+                   "facing-away"):
         assert any(needed in name for name in names), needed
 
 
