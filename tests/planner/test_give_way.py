@@ -135,10 +135,13 @@ def test_spot_aside_ahead_keeps_within_45_degrees_of_the_way() -> None:
 
 
 def test_the_lane_runs_against_a_head_on_mover_and_with_an_overtaking_one() -> None:
-    kw = dict(spot=(0.0, 0.5), side=1, radius=0.2, mover=3, way=(1.0, 0.0), until=60.0,
-              position=(-3.0, 0.0), velocity=(1.2, 0.0), at=0.0, seen=0.0, moving=0.0)
-    assert give_way.Hold(**kw).lane == (-1.0, -0.0)  # type: ignore[arg-type]
-    assert give_way.Hold(**kw, overtaking=True).lane == (1.0, 0.0)  # type: ignore[arg-type]
+    def hold(overtaking: bool) -> give_way.Hold:
+        return give_way.Hold(spot=(0.0, 0.5), side=1, radius=0.2, mover=3, way=(1.0, 0.0),
+                             until=60.0, position=(-3.0, 0.0), velocity=(1.2, 0.0), at=0.0,
+                             seen=0.0, moving=0.0, overtaking=overtaking)
+
+    assert hold(False).lane == (-1.0, -0.0)
+    assert hold(True).lane == (1.0, 0.0)
 
 
 def test_passed_once_behind_by_the_clearance() -> None:
@@ -173,11 +176,14 @@ def walker(x: float, y: float = 3.0) -> Obstacle:
     return Obstacle(7, "dynamic", (x, y), (-0.15, 0.0), 0.2, (0, 0, 0, 0))
 
 
-def map_walls(p: Planner, pose: tuple[float, float, float], until: float) -> float:
-    """Scans of the empty corridor every 0.1 s up to ``until`` (the walls confirmed)."""
+def map_walls(p: Planner, pose: tuple[float, float, float], until: float,
+              boxes: list[tuple[float, float, float, float]] = WALLS,
+              fov_deg: float = 180.0) -> float:
+    """Scans of the empty corridor (``boxes``) every 0.1 s up to ``until`` (the walls
+    confirmed)."""
     t = 0.0
     while t < until:
-        p.step(pose, [], t, scan_of(pose, boxes=WALLS))
+        p.step(pose, [], t, scan_of(pose, boxes=boxes, fov_deg=fov_deg))
         t = round(t + 0.1, 1)
     return t
 
@@ -248,12 +254,8 @@ def overtaker(x: float, y: float = 3.0, speed: float = 0.6) -> Obstacle:
 
 
 def map_wide(p: Planner, pose: tuple[float, float, float], until: float) -> float:
-    """Scans of the empty wide corridor, all round, every 0.1 s up to ``until``."""
-    t = 0.0
-    while t < until:
-        p.step(pose, [], t, scan_of(pose, boxes=WIDE, fov_deg=360.0))
-        t = round(t + 0.1, 1)
-    return t
+    """``map_walls`` for the wide corridor, all round."""
+    return map_walls(p, pose, until, WIDE, 360.0)
 
 
 def test_a_walker_overtaking_in_a_corridor_is_given_way_ahead_and_let_by() -> None:
