@@ -1175,9 +1175,9 @@ class Planner:
         if float(ahead @ way) < p.same_way_cos * length:
             return False  # not the robot's way
         clearance = p.robot_radius + max(mover.radius, p.robot_radius) + p.safety_margin
-        rel = robot - np.asarray(mover.position, dtype=np.float64)
-        behind = float(rel @ way)  # how far the robot is ahead of the mover along its way
-        if behind <= 0.0 or abs(float(way[0] * rel[1] - way[1] * rel[0])) >= clearance:
+        position = np.asarray(mover.position, dtype=np.float64)
+        behind = float((robot - position) @ way)  # the robot's lead on it along its way
+        if behind <= 0.0 or abs(float(offsets(robot[None, :], position, way)[0])) >= clearance:
             return False  # beside or ahead of the robot already, or passing it clear
         return (behind - clearance) / (speed - p.max_speed) <= p.horizon
 

@@ -144,9 +144,8 @@ def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
     along = (points - mover[None, :]) @ way
     ok = aside & ((along - clearance) / speed >= distance / robot_speed + lead)
     if ahead:
-        rel = points - robot[None, :]
-        forward = rel @ way
-        ok &= forward >= np.abs(way[0] * rel[:, 1] - way[1] * rel[:, 0]) - 1e-9
+        forward = (points - robot[None, :]) @ way
+        ok &= forward >= np.abs(offsets(points, robot, way)) - 1e-9
     if not ok.any():
         return None
     ok[ok] = ~blocked_at(points[ok])
