@@ -119,11 +119,22 @@ def draw_earlier_paths(ax: Any, paths: Sequence[GlobalPath]) -> None:
                     xytext=(-8, -8), fontsize=6, color=EARLIER_PATH_COLOUR)
 
 
+LEGEND_WIDTH = 2.8
+"""Inches beside the map kept for run.png's legend, so that it never hides the run."""
+
+
 def _finish(fig: Any, ax: Any, path: Path, legend: str) -> None:
-    """Axis labels and legend; write ``path`` and close the figure."""
+    """Axis labels and legend (``legend``: a matplotlib location inside the axes, or
+    ``"beside"``: to the right of them, in the room of ``LEGEND_WIDTH``); write ``path``
+    and close the figure."""
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.legend(loc=legend, fontsize=7)
+    if legend == "beside":
+        ax.set_anchor("W")  # the equal-aspect box at the left of its room, the legend next
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+                  fontsize=7)
+    else:
+        ax.legend(loc=legend, fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -152,7 +163,8 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
     numbered at its first vertex with its reason in the legend."""
     width, height = scenario.world.size
     with PLOT_LOCK:
-        fig, ax = _figure(7, 7 * height / width if width else 7)
+        # The map 7 in wide (at least 3 in high, for the legend's rows), the legend beside.
+        fig, ax = _figure(7 + LEGEND_WIDTH, max(7 * height / width if width else 7, 3.0))
         _world(ax, scenario, "0.92", max_cells=60)
         if occupancy is not None:
             draw_occupancy(ax, occupancy)
@@ -218,7 +230,7 @@ def plot_run(scenario: Scenario, record: dict[str, Any], path: Path,
         ax.set_title(f"{record['scenario']} ({record['planner']}): {outcome} at {end:.1f} s, "
                      f"path {record['path_length']:.2f} m, min clearance {clearance_text}",
                      fontsize=9)
-        _finish(fig, ax, path, "upper left")
+        _finish(fig, ax, path, "beside")
 
 
 LABEL_NEAR = 0.04
