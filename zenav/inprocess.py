@@ -1,7 +1,7 @@
 """The pipeline's cores called directly, without the bus: for timing them.
 
 :class:`Pipeline` holds the pure cores the services call (laser driver -> perception ->
-tracking -> planner -> motor bridge), set up with the same parameters as ``zenav run``,
+tracking -> planner), set up with the same parameters as ``zenav run``,
 and runs them on one scan at a time; ``zenav bench perf`` (its compute section) times it
 stage by stage with a :class:`StageClock`. It runs no scenario: a whole run in one
 process is the in-process engine's (:mod:`zenav.engine`, ``zenav run --engine
@@ -21,8 +21,6 @@ from typing_extensions import override
 from zenav.schemas.messages import LaserScan, Pose2D, RawLaserFrame, Track, TrackList
 from zenav.services.laser_driver.params import Params as DriverParams
 from zenav.services.laser_driver.scan import frame_to_scan
-from zenav.services.motor_bridge.command_filter import CommandFilter
-from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.perception.clustering import Clusters
 from zenav.services.perception.params import PerceptionParams
 from zenav.services.perception.perceive import Perceiver
@@ -101,10 +99,10 @@ class Step:
 
 
 class Pipeline:
-    """Laser driver, perception, tracking and planner (and the motor bridge's filter) as
-    the services set them up from ``params`` (per service, as :func:`stack_params` gives
-    them); each stage of :meth:`step` is timed on ``clock``, and with
-    ``time_planner_parts`` the planner's prediction and Morphin too."""
+    """Laser driver, perception, tracking and planner as the services set them up from
+    ``params`` (per service, as :func:`stack_params` gives them); each stage of
+    :meth:`step` is timed on ``clock``, and with ``time_planner_parts`` the planner's
+    prediction and Morphin too."""
 
     def __init__(self, params: dict[str, dict[str, Any]], clock: StageClock | None = None,
                  *, time_planner_parts: bool = False) -> None:
@@ -115,7 +113,6 @@ class Pipeline:
         self.planner_params = PlannerParams.model_validate(params["planner"])
         self.planner = (TimedPlanner(self.planner_params, self.clock) if time_planner_parts
                         else Planner(self.planner_params))
-        self.bridge = CommandFilter(BridgeParams.model_validate(params["motor_bridge"]))
 
     def step(self, t: float, seq: int, ranges: Any, pose: Pose) -> Step:
         """One scan (the simulator's ranges at ``t``, the robot at ``pose``) through the
