@@ -61,6 +61,10 @@ PROFILES: dict[str, dict[str, dict[str, Any]]] = {
             "escape_fan_deg": 85.0,  # = fan_max_deg: no wider escape fan
             "use_map": False,  # no map: the global path is the straight start-goal line
             "recovery": False,  # no progress checker, no recovery steps
+            # No stepping aside for a walker between walls: the paper's (f) detour. (It
+            # also needs the map, so with use_map off it could not act; said here so that
+            # `zenav params planner --profile paper` shows the paper's value.)
+            "give_way": False,
         },
     },
 }
