@@ -128,33 +128,6 @@ def scores_against(clustered: ClusterPoints, current: ScanSnapshot, past: ScanSn
     return scores
 
 
-def motion_scores(
-    current: ScanSnapshot,
-    cluster_beams: IntArray,
-    window_beams: IntArray,
-    past: ScanSnapshot,
-    past_beams: IntArray,
-    margin: float,
-    reach: float,
-    window_points: FloatArray | None = None,
-    past_points: FloatArray | None = None,
-) -> FloatArray:
-    """(n,) score in [0, 1] per cluster: how much of it moved since ``past``.
-
-    ``cluster_beams`` (n, 2) first/last beam of each cluster; ``window_beams`` the
-    current scan's beams inside the window; ``past_beams`` the same for ``past``.
-    ``reach`` m: how far from a cluster's points earlier points count as its own.
-    ``window_points`` and ``past_points``: the global points of ``window_beams`` and
-    ``past_beams`` when the caller has them already (:class:`MotionCue` keeps them).
-    """
-    clustered = cluster_points(current, cluster_beams, window_beams, reach, window_points)
-    if clustered is None:
-        return np.zeros(len(cluster_beams))
-    if past_points is None:
-        past_points = past.points(past_beams) if len(past_beams) >= 2 else np.empty((0, 2))
-    return scores_against(clustered, current, past, past_points, margin)
-
-
 class MotionCue:
     """Keeps the recent scans and scores each new scan's clusters against them."""
 

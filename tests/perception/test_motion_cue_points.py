@@ -1,5 +1,6 @@
-"""The motion cue with the points it keeps from scan to scan gives exactly the scores it
-gives computing them afresh, and a mover scores while a standing box does not."""
+"""The motion cue (``MotionCue``, as perception runs it): a mover scores while a standing
+post does not, each baseline's column is what a cue with that baseline alone gives, and
+the window clustering hands it gives the cue's own scores."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 from zenav.services.perception.clustering import scan_window
-from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot, motion_scores
+from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot
 
 BEAMS = 181
 ANGLE_MIN, STEP = -np.pi / 2, np.pi / 180
@@ -35,60 +36,35 @@ def clusters_of(s: ScanSnapshot) -> np.ndarray:
     return beams
 
 
-@pytest.mark.parametrize("seed", range(5))
-def test_kept_points_give_the_same_scores(seed: int) -> None:
-    rng = np.random.default_rng(seed)
-    standing = [(float(rng.uniform(2, 4)), float(rng.uniform(-2, 2))) for _ in range(3)]
-    mover = (3.0, -1.0)
-    past = scan(0.0, (0.0, 0.0, 0.0), [*standing, mover])
-    now = scan(0.5, (0.1, 0.0, 0.01), [*standing, (mover[0], mover[1] + 0.6)])
-    window, past_window = np.flatnonzero(now.ranges < 8.0), np.flatnonzero(past.ranges < 8.0)
-    clusters = clusters_of(now)
-    fresh = motion_scores(now, clusters, window, past, past_window, 0.1, 0.5)
-    kept = motion_scores(now, clusters, window, past, past_window, 0.1, 0.5,
-                         window_points=now.points(window), past_points=past.points(past_window))
-    assert np.array_equal(fresh, kept)
-
-
 def test_the_mover_scores_and_the_post_does_not() -> None:
     past = scan(0.0, (0.0, 0.0, 0.0), [(3.0, 1.5), (3.0, -1.0)])
     now = scan(0.5, (0.1, 0.0, 0.0), [(3.0, 1.5), (3.0, -0.4)])
-    window, past_window = np.flatnonzero(now.ranges < 8.0), np.flatnonzero(past.ranges < 8.0)
-    clusters = clusters_of(now)  # right to left: the mover, then the post
-    scores = motion_scores(now, clusters, window, past, past_window, 0.1, 0.5,
-                           window_points=now.points(window),
-                           past_points=past.points(past_window))
-    assert len(scores) == 2
-    assert scores[0] > 0.5 and scores[1] == 0.0
+    cue = MotionCue((0.5,), margin=0.1, reach=0.5, window_radius=8.0)
+    cue.score_each(past, 0.0, clusters_of(past))
+    scores, stamps = cue.score_each(now, 0.0, clusters_of(now))  # the mover, then the post
+    assert stamps.tolist() == [0.0]
+    assert scores.shape == (2, 1)
+    assert scores[0, 0] > 0.5 and scores[1, 0] == 0.0
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_each_baseline_scores_as_motion_scores_does_alone(seed: int) -> None:
+def test_each_baseline_scores_as_a_cue_with_that_baseline_alone(seed: int) -> None:
     """MotionCue builds the clusters' points once for all its baselines; each column of
-    score_each is what motion_scores gives against that baseline's scan, to the bit."""
-    from zenav.services.perception.motion_cue import MotionCue
-
+    score_each is what a cue with that one baseline gives on the same scans, to the bit."""
     rng = np.random.default_rng(seed)
     standing = [(float(rng.uniform(2, 4)), float(rng.uniform(-2, 2))) for _ in range(3)]
-    cue = MotionCue((0.2, 0.5), margin=0.1, reach=0.5, window_radius=4.0)
-    scans = []
+    baselines = (0.2, 0.5)
+    cue = MotionCue(baselines, margin=0.1, reach=0.5, window_radius=4.0)
+    alone = [MotionCue((b,), margin=0.1, reach=0.5, window_radius=4.0) for b in baselines]
     for k in range(8):
         mover = (3.0, -1.5 + 0.12 * k)
         s = scan(0.1 * k, (0.05 * k, 0.0, 0.01 * k), [*standing, mover])
-        scans.append(s)
-        clusters = clusters_of(s)
-        each, stamps = cue.score_each(s, 0.0, clusters)
+        each, stamps = cue.score_each(s, 0.0, clusters_of(s))
+        singles = [c.score_each(s, 0.0, clusters_of(s)) for c in alone]
+        for j, (one, one_stamps) in enumerate(singles):
+            assert np.array_equal(each[:, j], one[:, 0])
+            assert np.array_equal(stamps[j:j + 1], one_stamps, equal_nan=True)
     assert np.all(np.isfinite(stamps)) and each.any()
-    now = scans[-1]
-
-    def window(x: ScanSnapshot) -> np.ndarray:
-        beams: np.ndarray = np.flatnonzero((x.ranges < 8.0) & (x.ranges <= 4.0))
-        return beams
-
-    for j, stamp in enumerate(stamps):
-        past = next(x for x in scans if abs(x.stamp - stamp) < 1e-12)
-        alone = motion_scores(now, clusters_of(now), window(now), past, window(past), 0.1, 0.5)
-        assert np.array_equal(each[:, j], alone)
 
 
 @pytest.mark.parametrize("seed", range(3))
