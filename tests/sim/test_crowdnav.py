@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import itertools
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -65,18 +65,27 @@ def test_no_start_or_goal_is_within_the_discomfort_gap_of_an_earlier_one(layout)
             placed.append((px, py, gx, gy))
 
 
+class CountingState(np.random.RandomState):
+    """A RandomState that counts its ``random_sample`` draws."""
+
+    draws = 0
+
+    def random_sample(self, *args: Any, **kwargs: Any) -> Any:
+        self.draws += 1
+        return super().random_sample(*args, **kwargs)
+
+
 def test_the_rule_redraws_rather_than_skips():
-    """Some draws do land too close (the same seeds, without the rule, would overlap)."""
-    close = 0
+    """Some draws do land too close: circle_crossing draws again (three numbers a try)
+    on some of these seeds, and still places every human (the test above holds anyway)."""
+    redrawn = 0
     for case in range(100):
-        rng = np.random.RandomState(1000 + case)
-        starts = []
-        for _ in range(5):
-            angle = rng.random_sample() * 2 * math.pi
-            starts.append((4 * math.cos(angle) + rng.random_sample() - 0.5,
-                           4 * math.sin(angle) + rng.random_sample() - 0.5))
-        close += any(math.dist(a, b) < GAP for a, b in itertools.combinations(starts, 2))
-    assert close > 0  # the rule matters on these seeds, and the test above holds anyway
+        rng = CountingState(1000 + case)
+        humans = circle_crossing(rng)
+        assert len(humans) == 5
+        assert rng.draws % 3 == 0 and rng.draws >= 15
+        redrawn += rng.draws > 15
+    assert redrawn > 0
 
 
 @pytest.mark.parametrize("case", range(0, 500, 11))
