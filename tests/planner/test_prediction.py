@@ -1,4 +1,5 @@
-"""Collision prediction (``prediction.assess``, what the planner calls per obstacle) on
+"""Collision prediction (``prediction.assess``: one obstacle through ``assess_all``, which
+the planner calls on all of them at once) on
 hand-made geometry: one case per scenario letter (b)-(g), the planner's (a) and (h), and
 the cases either side of every threshold (the 12 s horizon, cos <= -0.8 for head-on,
 cos >= 0.8 for same-way, moving_speed).
