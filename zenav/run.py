@@ -12,6 +12,7 @@ import asyncio
 import contextlib
 import json
 import math
+import os
 import signal
 import threading
 import time
@@ -318,23 +319,33 @@ def sigint_held() -> Iterator[None]:
 
 @contextlib.contextmanager
 def _interrupt_sets(stop: threading.Event) -> Iterator[None]:
-    """In the main thread: SIGINT sets ``stop`` and raises KeyboardInterrupt (once; a
-    second one while the stack stops is ignored, so the stop is not cut short). Elsewhere
-    (a batch's worker thread) nothing: the batch sets ``stop`` itself."""
+    """In the main thread: SIGINT or SIGTERM sets ``stop`` and raises KeyboardInterrupt
+    (once; a second signal while the stack stops is ignored, so the stop is not cut
+    short). After a SIGTERM (``timeout``, a supervisor, a CI job) the command then ends
+    by that signal's default action, status 143 to a shell, once the block has stopped
+    the services: without this, SIGTERM killed the command at once and left the six
+    services running. Elsewhere (a batch's worker thread) nothing: the batch sets
+    ``stop`` itself."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    received: list[int] = []
 
-    def on_sigint(signum: int, frame: FrameType | None) -> None:
+    def on_signal(signum: int, frame: FrameType | None) -> None:
         if not stop.is_set():
+            received.append(signum)
             stop.set()
             raise KeyboardInterrupt
 
-    previous = signal.signal(signal.SIGINT, on_sigint)
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if signal.SIGTERM in received:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
 
 
 def run_scenario(

@@ -1,6 +1,7 @@
 """Ctrl-C on ``zenav run`` and ``zenav paper`` (stack engine): status 130 within 3 s, no
 traceback, and no service process left behind, whether the signal reaches the command
-only (``kill -INT PID``) or its whole process group (a terminal's Ctrl-C)."""
+only (``kill -INT PID``) or its whole process group (a terminal's Ctrl-C). SIGTERM to the
+command alone (``timeout``, a supervisor) ends it by that signal, its services stopped."""
 
 from __future__ import annotations
 
@@ -33,8 +34,9 @@ def long_run(folder: Path) -> Path:
     return path
 
 
-def interrupt(argv: list[str], after: float, group: bool, cwd: Path) -> tuple[int, float, str]:
-    """Start ``zenav ARGV``, send SIGINT after ``after`` s; (status, s to stop, stderr)."""
+def interrupt(argv: list[str], after: float, group: bool, cwd: Path,
+              sig: signal.Signals = signal.SIGINT) -> tuple[int, float, str]:
+    """Start ``zenav ARGV``, send ``sig`` after ``after`` s; (status, s to stop, stderr)."""
     with sigint_as_usual():
         proc = subprocess.Popen([sys.executable, "-m", "zenav", *argv], cwd=cwd,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
@@ -43,9 +45,9 @@ def interrupt(argv: list[str], after: float, group: bool, cwd: Path) -> tuple[in
     assert proc.poll() is None, f"zenav {argv[0]} ended before Ctrl-C was sent"
     sent = time.monotonic()
     if group:
-        os.killpg(proc.pid, signal.SIGINT)
+        os.killpg(proc.pid, sig)
     else:
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
     try:
         _, err = proc.communicate(timeout=30)
     except subprocess.TimeoutExpired:
@@ -69,6 +71,17 @@ def test_zenav_run_stops_on_ctrl_c_with_130(tmp_path: Path, after: float, group:
                                 group, tmp_path)
     assert code == 130, err
     assert "Traceback" not in err and "exited with status" not in err, err
+    assert took < 3.0
+    time.sleep(0.5)
+    assert services_of(out) == []
+
+
+def test_zenav_run_stops_its_services_on_sigterm(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    code, took, err = interrupt(["run", str(long_run(tmp_path)), "--out", str(out)], 4.0,
+                                False, tmp_path, signal.SIGTERM)
+    assert code == -signal.SIGTERM, err
+    assert "Traceback" not in err, err
     assert took < 3.0
     time.sleep(0.5)
     assert services_of(out) == []
