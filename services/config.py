@@ -37,7 +37,8 @@ SERVICE_ORDER: tuple[str, ...] = (
 """The six processes of a stack, in the order their loopback ports are numbered."""
 
 DEFAULT_BASE_PORT = 7450
-"""First loopback port of the embedded default mesh (7450..7455, one per service)."""
+"""First loopback port of the embedded default mesh (7450..7455, one per service; 7456 for
+the tools)."""
 
 
 class ConfigError(ValueError):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import reprlib
+from collections.abc import Hashable
 from typing import Any, NoReturn
 
 import yaml
@@ -69,13 +70,25 @@ def _children(node: yaml.Node) -> list[yaml.Node]:
 
 class BoundedLoader(yaml.SafeLoader):
     """``yaml.SafeLoader`` that refuses documents whose aliases expand too far
-    (:class:`AliasError`, a ``yaml.YAMLError``), checked before any object is built."""
+    (:class:`AliasError`, a ``yaml.YAMLError``), checked before any object is built, and
+    a mapping that names a key twice (PyYAML would keep the last one without a word, so a
+    parameter set twice in a file would silently lose its first value)."""
 
     def get_single_node(self) -> Any:
         node = super().get_single_node()
         if node is not None:
             _expanded_size(node)
         return node
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Hashable, Any]:
+        seen: set[object] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r}", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
 
 
 def safe_load(text: str, loader: type[BoundedLoader] = BoundedLoader) -> Any:

@@ -132,11 +132,14 @@ def implementation(name: str, planner: str = "paper") -> Implementation:
 
 
 
-def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
-    """Options every process that joins the bus shares (services and tools)."""
+def add_transport_arguments(parser: argparse.ArgumentParser, *, robot_id: bool = True) -> None:
+    """Options every process that joins the bus shares (services and tools). A tool whose
+    robot id comes from elsewhere (``zenav replay``: the recorded one) leaves out
+    ``--robot-id`` (``robot_id=False``), so that a user who gives it hears it is not used."""
     group = parser.add_argument_group("transport")
-    group.add_argument("--robot-id", default="robot0",
-                       help="robot id in every key (default robot0)")
+    if robot_id:
+        group.add_argument("--robot-id", default="robot0",
+                           help="robot id in every key (default robot0)")
     group.add_argument("--transport", type=Path, metavar="FILE",
                        help="YAML file of transport settings (a TransportConfig: mode, "
                             "listen, connect, ...)")
@@ -157,8 +160,9 @@ def add_transport_arguments(parser: argparse.ArgumentParser) -> None:
         type=base_port,
         default=DEFAULT_BASE_PORT,
         help="first port of the loopback mesh used when no endpoint is given "
-             f"(default {DEFAULT_BASE_PORT}: tcp/127.0.0.1:{DEFAULT_BASE_PORT}..."
-             f"{DEFAULT_BASE_PORT + 5})",
+             f"(default {DEFAULT_BASE_PORT}: a service on each of tcp/127.0.0.1:"
+             f"{DEFAULT_BASE_PORT}...{DEFAULT_BASE_PORT + len(SERVICE_ORDER) - 1}, the "
+             f"tools on {DEFAULT_BASE_PORT + len(SERVICE_ORDER)})",
     )
 
 
@@ -205,7 +209,16 @@ def transport_from_args(args: argparse.Namespace, service: str | None) -> Transp
         config = loopback_mesh(service, args.base_port)
     if args.mode is not None:
         config = config.model_copy(update={"mode": args.mode})
+    check_finds_a_router(config, args)
     return config
+
+
+def check_finds_a_router(config: TransportConfig, args: argparse.Namespace) -> None:
+    """ConfigError when ``config`` is a client that could never reach a router."""
+    if config.finds_no_router():
+        source = f"{args.transport}: " if args.transport is not None else ""
+        raise ConfigError(f"{source}mode client needs a router to connect to: give connect: "
+                          "[ENDPOINT] (or --connect ENDPOINT)")
 
 
 def add_standby_argument(parser: argparse.ArgumentParser) -> None:

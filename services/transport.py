@@ -97,6 +97,12 @@ class TransportConfig(BaseModel):
         default_factory=dict, description="further Zenoh settings, path -> JSON value"
     )
 
+    def finds_no_router(self) -> bool:
+        """A client with nowhere to look for its router: no endpoint to connect to and
+        multicast scouting off. Its session could never open."""
+        return (self.mode == "client" and not self.connect and not self.multicast_scouting
+                and "connect/endpoints" not in self.extra)
+
     def to_zenoh(self) -> zenoh.Config:
         conf = zenoh.Config()
         conf.insert_json5("mode", json.dumps(self.mode))

@@ -21,7 +21,7 @@ from typing import Any, TypeVar
 
 from zenav.argtypes import positive_float
 from zenav.services.config import ConfigError, loopback_mesh, read_transport, tool_port
-from zenav.services.runner import transport_from_args
+from zenav.services.runner import check_finds_a_router, transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus
 
 log = logging.getLogger(__name__)
@@ -66,6 +66,7 @@ def tool_transport(args: argparse.Namespace) -> TransportConfig:
         config = read_transport(args.transport)
         if args.mode is not None:
             config = config.model_copy(update={"mode": args.mode})
+        check_finds_a_router(config, args)
         config = with_client_defaults(config)
     else:
         config = transport_from_args(args, None)
@@ -136,12 +137,19 @@ class ConnectError(RuntimeError):
     """The session could not be opened; the message is the one-line reason."""
 
 
+def router_place(transport: TransportConfig) -> str:
+    """Where a client looks for its router, for a message: ``at ENDPOINTS`` or ``found by
+    multicast scouting``."""
+    if transport.connect:
+        return f"at {', '.join(transport.connect)}"
+    return "found by multicast scouting"
+
+
 def connect_problem(transport: TransportConfig, timeout: float, exc: BaseException | None
                     ) -> str:
     """The one line a tool prints when its session does not open."""
     if transport.mode == "client":
-        where = ", ".join(transport.connect) or "(no endpoint)"
-        return f"no Zenoh router at {where} after {timeout:g} s: is it running?"
+        return f"no Zenoh router {router_place(transport)} after {timeout:g} s: is it running?"
     detail = f": {str(exc).split(' at ')[0]}" if exc is not None else ""
     return f"cannot open a Zenoh {transport.mode} session within {timeout:g} s{detail}"
 
@@ -217,7 +225,7 @@ async def open_bus(transport: TransportConfig, stop: asyncio.Event,
             await asyncio.wait({opened, stopped}, timeout=WAITING_NOTE_AFTER,
                                return_when=asyncio.FIRST_COMPLETED)
             if not (opened.done() or stopped.done()):
-                print(f"{command}: waiting for the router at {', '.join(transport.connect)} "
+                print(f"{command}: waiting for the router {router_place(transport)} "
                       f"(up to {timeout:g} s)", file=sys.stderr, flush=True)
         await asyncio.wait({opened, stopped}, timeout=timeout + 1.0,
                            return_when=asyncio.FIRST_COMPLETED)

@@ -44,6 +44,12 @@ def a_file(tmp: Path) -> Path:
     return path
 
 
+def a_text(tmp: Path, name: str, text: str) -> Path:
+    path = tmp / name
+    path.write_text(text)
+    return path
+
+
 def a_bag(tmp: Path) -> Path:
     path = tmp / "run.mcap"
     with path.open("wb") as stream:
@@ -200,6 +206,34 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      "zenav run: unrecognized arguments: --bogus"),
     ("an unknown flag of a bench", lambda t: ["bench", "crowd", "--bogus"], 2,
      "zenav bench crowd: unrecognized arguments: --bogus"),
+    ("replay a file shorter than MCAP's magic",
+     lambda t: ["replay", str(a_text(t, "short.mcap", "hello")), "--connect", "tcp/127.0.0.1:9"],
+     2, "zenav replay: {t}/short.mcap: not an MCAP file (or cut short)"),
+    ("replay an empty file",
+     lambda t: ["replay", str(a_text(t, "empty.mcap", "")), "--connect", "tcp/127.0.0.1:9"], 2,
+     "zenav replay: {t}/empty.mcap: not an MCAP file (or cut short)"),
+    ("replay --robot-id, which the recorded id decides",
+     lambda t: ["replay", str(a_bag(t)), "--robot-id", "robot1", "--connect", "tcp/127.0.0.1:9"],
+     2, "zenav replay: --robot-id: replay publishes under the robot id recorded in the file; "
+     "give --as-robot ID to publish under another"),
+    ("monitor as a client with no router to connect to",
+     lambda t: ["monitor", "--transport", str(a_text(t, "client.yaml", "mode: client\n"))], 2,
+     "zenav monitor: {t}/client.yaml: mode client needs a router to connect to: give connect: "
+     "[ENDPOINT] (or --connect ENDPOINT)"),
+    ("a service as a client with no router to connect to",
+     lambda t: ["service", "tracking", "--transport",
+                str(a_text(t, "client.yaml", "mode: client\n"))], 2,
+     "zenav tracking: {t}/client.yaml: mode client needs a router to connect to: give "
+     "connect: [ENDPOINT] (or --connect ENDPOINT)"),
+    ("params from a file that sets one twice",
+     lambda t: ["params", "planner", "--params",
+                str(a_text(t, "twice.yaml", "cruise_speed: 0.2\ncruise_speed: 0.3\n"))], 2,
+     "zenav params: {t}/twice.yaml: not valid YAML (duplicate key 'cruise_speed' (line 2, "
+     "column 1))"),
+    ("a transport file that sets one twice",
+     lambda t: ["record", str(t / "x.mcap"), "--transport",
+                str(a_text(t, "twice.yaml", "mode: peer\nmode: client\n"))], 2,
+     "zenav record: {t}/twice.yaml: not valid YAML (duplicate key 'mode' (line 2, column 1))"),
 ]
 
 

@@ -97,3 +97,12 @@ def test_the_router_names_the_field_of_a_bad_transport_file(
     code, err = zenav(["router", "--transport", str(path)], capsys)
     assert (code, err) == (2, [f"zenav router: {path}: connect.0: 'garbage' is not a Zenoh "
                                "endpoint: expected PROTOCOL/ADDRESS, e.g. tcp/127.0.0.1:7447"])
+
+
+def test_only_a_client_with_no_way_to_find_a_router_finds_none() -> None:
+    assert TransportConfig(mode="client").finds_no_router()
+    assert not TransportConfig(mode="client", connect=["tcp/127.0.0.1:7447"]).finds_no_router()
+    assert not TransportConfig(mode="client", multicast_scouting=True).finds_no_router()
+    assert not TransportConfig(mode="client", extra={"connect/endpoints": ["tcp/10.0.0.1:7447"]}
+                               ).finds_no_router()
+    assert not TransportConfig(mode="peer").finds_no_router()  # a peer may wait to be found

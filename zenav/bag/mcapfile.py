@@ -5,6 +5,7 @@ decoding it."""
 from __future__ import annotations
 
 import json
+import struct
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -173,7 +174,7 @@ def bag_contents(path: Path) -> tuple[str, set[str]]:
         return robot, {item.topic for item in read_bag(path)}
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    except McapError:
+    except (McapError, struct.error):  # struct.error: shorter than MCAP's 8-byte magic
         raise ValueError(f"{path}: not an MCAP file (or cut short)") from None
 
 

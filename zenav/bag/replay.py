@@ -139,6 +139,9 @@ async def replay(transport: Any, path: Path, *, rate: float, topics: set[str] | 
 def main(args: argparse.Namespace) -> int:
     topics = {t.strip() for t in args.topics.split(",") if t.strip()} or None
     try:
+        if args.robot_id is not None:
+            raise ValueError("--robot-id: replay publishes under the robot id recorded in the "
+                             "file; give --as-robot ID to publish under another")
         wait_for = parse_wait_for(args.wait_for)
         transport = tool_transport(args)
         if args.as_robot is not None:
@@ -178,6 +181,7 @@ def add_command(sub: Any) -> None:
                         f"(any of {', '.join(WAITABLE)}; default none)")
     replay.add_argument("--timeout", type=positive_float, default=30.0,
                         help="s to wait for --wait-for (default 30)")
-    add_transport_arguments(replay)
+    add_transport_arguments(replay, robot_id=False)  # the recorded one, or --as-robot
+    replay.add_argument("--robot-id", metavar="ID", help=argparse.SUPPRESS)  # refused in main
     add_connect_timeout(replay)
     replay.set_defaults(func=main)
