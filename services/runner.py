@@ -428,11 +428,15 @@ def main(name: str, argv: list[str] | None = None) -> int:
         loop = asyncio.get_running_loop()
         session = await opening.session() if opening is not None else None
         bus = ZenohBus(transport, loop, session=session)
+        log.info("on the bus for robot %s: Zenoh %s, listening on %s, connecting to %s",
+                 keys.robot_id, transport.mode, ", ".join(transport.listen) or "nothing",
+                 ", ".join(transport.connect) or "nothing")
         try:
             await serve(name, bus, keys, params, planner)
         finally:
             bus.close()
         _CLOSED.append(name)
+        log.info("stopped")
 
     try:
         implementation(name, planner)  # the service's modules, while the session opens
@@ -444,6 +448,8 @@ def main(name: str, argv: list[str] | None = None) -> int:
         if opening is not None:
             opening.abandon()
         log.debug("service %s failed", name, exc_info=True)
-        log.error("service %s failed: %s: %s", name, type(exc).__name__, exc)
+        # Zenoh's errors end with the place in its Rust source: of no use to the reader.
+        log.error("service %s failed: %s: %s", name, type(exc).__name__,
+                  str(exc).split("  at /")[0])
         return 1
     return 0
