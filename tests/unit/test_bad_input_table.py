@@ -225,6 +225,12 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
                 str(a_text(t, "client.yaml", "mode: client\n"))], 2,
      "zenav tracking: {t}/client.yaml: mode client needs a router to connect to: give "
      "connect: [ENDPOINT] (or --connect ENDPOINT)"),
+    ("up a deployment whose clients have no router to connect to",
+     lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
+                str(a_text(t, "d.yaml", "name: d\ntransport: {mode: client}\nservices: {}\n"))],
+     2,
+     "zenav up: {t}/d.yaml: transport: mode client needs a router to connect to: give "
+     "connect: [ENDPOINT] (or --connect ENDPOINT)"),
     ("params from a file that sets one twice",
      lambda t: ["params", "planner", "--params",
                 str(a_text(t, "twice.yaml", "cruise_speed: 0.2\ncruise_speed: 0.3\n"))], 2,

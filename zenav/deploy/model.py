@@ -208,6 +208,9 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
     check_program_params(deployment, path, list(overrides))
     if connect:
         deployment.transport = deployment.transport.model_copy(update={"connect": connect})
+    if deployment.transport.finds_no_router():
+        raise ConfigError(f"{path}: transport: mode client needs a router to connect to: "
+                          "give connect: [ENDPOINT] (or --connect ENDPOINT)")
     deployment.transport = with_client_defaults(deployment.transport)
     return deployment
 
