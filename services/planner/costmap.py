@@ -86,6 +86,31 @@ class ScanData:
 G = TypeVar("G", bound=np.generic)
 
 
+def _on_grid_steps(x: float, y: float, dx: float, dy: float, step: float, count: int,
+                   origin: tuple[float, float], shape: tuple[int, int], resolution: float
+                   ) -> tuple[int, int] | None:
+    """The first and last of the points ``(x, y) + k * step * (dx, dy)``, k = 0 ..
+    ``count`` - 1, that may lie on a grid of ``shape`` cells from ``origin`` (its box grown
+    by a cell each way, so that rounding never leaves one out); None when none does."""
+    if step <= 0.0:
+        return 0, count - 1
+    lo, hi = 0.0, (count - 1) * step  # the way's span, m along it
+    for start, d, corner, cells in ((x, dx, origin[0], shape[0]),
+                                    (y, dy, origin[1], shape[1])):
+        low = corner - resolution
+        high = low + (cells + 2) * resolution
+        if d == 0.0:
+            if not low <= start <= high:
+                return None
+            continue
+        a, b = (low - start) / d, (high - start) / d
+        lo, hi = max(lo, min(a, b)), min(hi, max(a, b))
+    if lo > hi:
+        return None
+    first, last = max(0, math.floor(lo / step)), min(count - 1, math.ceil(hi / step))
+    return (first, last) if first <= last else None
+
+
 def _flat(grid: npt.NDArray[G]) -> npt.NDArray[G]:
     """A flat view of a grid (never a copy: the grids are C-contiguous)."""
     flat = grid.reshape(-1)
@@ -450,10 +475,24 @@ class Costmap:
         ``start`` along ``direction`` (unit) for ``length`` m, both ends included (the
         points of ``prediction.path_points``), lies in a blocked cell (beyond the grid:
         free, as for ``blocked_at``); in compiled code (``_loops.line_any``), stopping at
-        the first."""
+        the first. Only the points on the grid are looked at, so the cost is bounded by
+        the grid's size however far the way reaches (a pose a bad message puts 1e15 m
+        away must not hold the planner for ever)."""
         grid = self.blocked()
-        return line_any(start[0], start[1], direction[0], direction[1], length, count,
-                        float(self.origin[0]), float(self.origin[1]), self.resolution,
+        x, y = start
+        dx, dy = direction
+        ox, oy = float(self.origin[0]), float(self.origin[1])
+        if count > 1:
+            on_grid = _on_grid_steps(x, y, dx, dy, length / (count - 1), count,
+                                     (ox, oy), self.shape, self.resolution)
+            if on_grid is None:
+                return False
+            first, last = on_grid
+            if (first, last) != (0, count - 1):
+                step = length / (count - 1)
+                x, y = x + dx * step * first, y + dy * step * first
+                length, count = step * (last - first), last - first + 1
+        return line_any(x, y, dx, dy, length, count, ox, oy, self.resolution,
                         _flat(grid).view(np.uint8), self.shape[1], False)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:

@@ -260,6 +260,39 @@ def test_blocked_along_looks_up_the_points_of_path_points(seed: int) -> None:
     assert 0 < hits < 50
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_blocked_along_from_far_away_looks_only_at_the_points_on_the_grid(seed: int) -> None:
+    """A way that starts tens to hundreds of metres off the grid, toward it or past it, is
+    ``blocked_at`` of all its points (those off the grid are free); one that starts 1e15 m
+    away (a pose a bad message may carry) is answered without walking its 4e16 points."""
+    rng = np.random.default_rng(1000 + seed)
+    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                 confirm=0.0, padding=1.0, max_size=30.0)
+    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
+                       math.pi / 180, 8.0), 0.0)
+    hits = 0
+    for _ in range(40):
+        bearing = rng.uniform(-math.pi, math.pi)
+        start = np.array([2.0, 1.5]) + rng.uniform(20.0, 300.0) * np.array(
+            [math.cos(bearing), math.sin(bearing)])
+        aim = rng.uniform(-1.0, 5.0, 2)  # a point on or near the grid
+        offset = aim - start
+        direction = offset / np.hypot(*offset)
+        length = float(np.hypot(*offset) + rng.uniform(-5.0, 10.0))
+        want = bool(cm.blocked_at(path_points(start, direction, length, 0.05)).any())
+        got = cm.blocked_along((float(start[0]), float(start[1])),
+                               (float(direction[0]), float(direction[1])), length,
+                               path_count(length, 0.05))
+        assert got == want
+        hits += want
+    assert 0 < hits < 40
+    far = 1e15
+    assert not cm.blocked_along((far, far), (1.0, 0.0), far, path_count(far, 0.025))
+    toward = (-math.sqrt(0.5), -math.sqrt(0.5))
+    assert isinstance(cm.blocked_along((far, far), toward, far * math.sqrt(2.0),
+                                       path_count(far * math.sqrt(2.0), 0.025)), bool)
+
+
 @pytest.mark.parametrize("seed", range(5))
 def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
     """``blocked_rows`` (compiled ``look_up_rows``) is ``blocked_at`` of every point, any

@@ -101,3 +101,20 @@ async def test_the_bridge_lets_a_bounded_reverse_through_only_when_allowed():
             await h.settle()
             out = h.received(keys.BASE_CMD, BaseCommand)
         assert out[-1].v == expected
+
+
+async def test_a_pose_a_bad_message_puts_1e15_m_away_does_not_hold_the_planner():
+    """Schema-valid (finite) but absurd: the map and the global path look only at their
+    grid, so the planner answers that stamp and the next ones as usual."""
+    async with running("planner", params()) as h:
+        h.send(keys.SCAN, scan(0.0))
+        h.send(keys.TRACKS, tracks(0.0))
+        await h.settle()
+        far = TrackList(stamp=0.1, seq=1, pose=Pose2D(x=1e15, y=1e15, heading=0.0), tracks=[])
+        h.send(keys.SCAN, scan(0.1))
+        h.send(keys.TRACKS, far)
+        await h.settle()
+        h.send(keys.SCAN, scan(0.2))
+        h.send(keys.TRACKS, tracks(0.2))
+        await h.settle()
+        assert [c.stamp for c in h.received(keys.CMD_VEL, VelocityCommand)] == [0.0, 0.1, 0.2]
