@@ -36,7 +36,13 @@ from zenav.services.config import (
     read_transport,
 )
 from zenav.services.inputs import OneLineParser
-from zenav.services.transport import Bus, TransportConfig, ZenohBus, check_endpoint
+from zenav.services.transport import (
+    Bus,
+    TransportConfig,
+    ZenohBus,
+    check_endpoint,
+    zenoh_problem,
+)
 from zenav.services.writable import PathError, check_output_file
 
 if TYPE_CHECKING:
@@ -448,8 +454,6 @@ def main(name: str, argv: list[str] | None = None) -> int:
         if opening is not None:
             opening.abandon()
         log.debug("service %s failed", name, exc_info=True)
-        # Zenoh's errors end with the place in its Rust source: of no use to the reader.
-        log.error("service %s failed: %s: %s", name, type(exc).__name__,
-                  str(exc).split("  at /")[0])
+        log.error("service %s failed: %s: %s", name, type(exc).__name__, zenoh_problem(exc))
         return 1
     return 0

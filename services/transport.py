@@ -18,6 +18,7 @@ import contextlib
 import functools
 import json
 import logging
+import re
 import threading
 import uuid
 from abc import ABC, abstractmethod
@@ -73,6 +74,15 @@ def check_endpoint(endpoint: str) -> str:
 
 Endpoint = Annotated[str, AfterValidator(check_endpoint)]
 """A Zenoh endpoint, checked by :func:`check_endpoint`."""
+
+
+_RUST_PLACE = re.compile(r"\s+at /\S+\.rs:\d+\.?")
+
+
+def zenoh_problem(exc: BaseException) -> str:
+    """A Zenoh error's text without the places in Zenoh's Rust source it names (`` at
+    /root/.cargo/.../tcp.rs:61.``), of no use to the reader, on one line."""
+    return " ".join(_RUST_PLACE.sub("", str(exc)).split())
 
 
 class TransportConfig(BaseModel):

@@ -22,7 +22,7 @@ from typing import Any, TypeVar
 from zenav.argtypes import positive_float
 from zenav.services.config import ConfigError, loopback_mesh, read_transport, tool_port
 from zenav.services.runner import check_finds_a_router, transport_from_args
-from zenav.services.transport import TransportConfig, ZenohBus
+from zenav.services.transport import TransportConfig, ZenohBus, zenoh_problem
 
 log = logging.getLogger(__name__)
 
@@ -150,7 +150,7 @@ def connect_problem(transport: TransportConfig, timeout: float, exc: BaseExcepti
     """The one line a tool prints when its session does not open."""
     if transport.mode == "client":
         return f"no Zenoh router {router_place(transport)} after {timeout:g} s: is it running?"
-    detail = f": {str(exc).split(' at ')[0]}" if exc is not None else ""
+    detail = f": {zenoh_problem(exc)}" if exc is not None else ""
     return f"cannot open a Zenoh {transport.mode} session within {timeout:g} s{detail}"
 
 

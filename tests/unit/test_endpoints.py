@@ -106,3 +106,18 @@ def test_only_a_client_with_no_way_to_find_a_router_finds_none() -> None:
     assert not TransportConfig(mode="client", extra={"connect/endpoints": ["tcp/10.0.0.1:7447"]}
                                ).finds_no_router()
     assert not TransportConfig(mode="peer").finds_no_router()  # a peer may wait to be found
+
+
+def test_a_zenoh_error_is_shown_without_the_places_in_zenohs_source() -> None:
+    from zenav.services.transport import zenoh_problem
+
+    text = ("Can not create a new TCP listener bound to tcp/127.0.0.1:7447: [127.0.0.1:7447: "
+            "Address already in use (os error 98) at /root/.cargo/git/checkouts/zenoh-9c5/"
+            "cc83980/io/zenoh-links/zenoh-link-tcp/src/unicast.rs:61.] at /root/.cargo/git/"
+            "checkouts/zenoh-9c5/cc83980/zenoh/src/net/runtime/orchestrator.rs:338.")
+    assert zenoh_problem(RuntimeError(text)) == (
+        "Can not create a new TCP listener bound to tcp/127.0.0.1:7447: [127.0.0.1:7447: "
+        "Address already in use (os error 98)]")
+    assert zenoh_problem(RuntimeError("Unable to connect to any of [tcp/1.2.3.4:7447]!  at "
+                                      "/x/orchestrator.rs:447.")) == (
+        "Unable to connect to any of [tcp/1.2.3.4:7447]!")

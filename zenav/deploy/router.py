@@ -28,7 +28,7 @@ from zenav.services.runner import (
     take_over,
     transport_from_args,
 )
-from zenav.services.transport import TransportConfig
+from zenav.services.transport import TransportConfig, zenoh_problem
 
 log = logging.getLogger(__name__)
 
@@ -85,7 +85,8 @@ def main(args: argparse.Namespace) -> int:
     try:
         session: Any = zenoh.open(transport.to_zenoh())
     except Exception as exc:
-        log.error("cannot open the router on %s: %s", ", ".join(transport.listen), exc)
+        log.error("cannot open the router on %s: %s", ", ".join(transport.listen),
+                  zenoh_problem(exc))
         return 1
     token = session.liveliness().declare_token(token_key(args.robot_id))
     joining = f", joining the routers at {', '.join(transport.connect)}" if transport.connect \
