@@ -22,6 +22,7 @@ import pytest
 
 from tests.integration.livestack import REPO, Deployed, copy_deployment, run, zenav
 from zenav.bag.mcapfile import BagWriter
+from zenav.deploy.rpc import Supervisor
 from zenav.launch import free_port_block
 from zenav.schemas.codec import encode
 from zenav.schemas.messages import Odometry, Pose2D
@@ -207,8 +208,11 @@ def test_up_reports_a_program_that_exits_at_start_with_its_own_line(tmp_path: Pa
         lines = done.stderr.splitlines()
         assert len(lines) == 1, done.stderr
         assert lines[0].startswith("zenav up: could not start laser: laser "), lines
-        assert lines[0].endswith(": zenav laser: cannot open /dev/ttyUSB9"), lines
+        assert lines[0].endswith(": zenav laser: cannot open /dev/ttyUSB9; stopped what it "
+                                 "had started"), lines
         assert took < 45, f"{took:.1f} s to report it"
+        # Nothing it started is left: the other programs would run without the laser.
+        assert Supervisor(stack.run_dir).pid() is None
     finally:
         stack.cleanup()
     starts = (stack.run_dir / "logs" / "laser.log").read_text().count("cannot open")

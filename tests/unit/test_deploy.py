@@ -222,3 +222,18 @@ def test_standby_pairs_every_service_and_the_router_with_a_warm_spare(tmp_path):
                                 str(tmp_path / "run" / "standby" / f"{name}.lock")]
         assert conf[f"program:{name}"]["priority"] == conf[f"program:{name}_standby"]["priority"]
     assert "--standby-lock" not in conf["program:planner_b"]["command"]
+
+
+def test_a_programs_reason_is_its_last_error_without_the_log_records_time_and_level(tmp_path):
+    from zenav.deploy.wait import _reason
+
+    log = tmp_path / "router.log"
+    log.write_text("2026-12-05 18:03:26,100 router INFO starting\n"
+                   "2026-12-05 18:03:26,960 router ERROR cannot open the router on "
+                   "tcp/0.0.0.0:7447: Address already in use (os error 98)\n"
+                   "2026-12-05 18:03:27,000 router INFO bye\n")
+    assert _reason(log) == ("cannot open the router on tcp/0.0.0.0:7447: Address already in "
+                            "use (os error 98)")
+    log.write_text("zenav laser: cannot open /dev/ttyUSB9\n")
+    assert _reason(log) == "zenav laser: cannot open /dev/ttyUSB9"
+    assert _reason(tmp_path / "none.log") == "(no log)"

@@ -92,13 +92,23 @@ def cmd_up(args: argparse.Namespace) -> int:
         if deployment.router is not None:
             programs.insert(0, "router")
         programs += standby_twins(deployment).values()
-        wait_running(sup, programs, args.timeout)
-        if not args.no_wait:
-            missing = wait_alive(deployment, expected_alive(deployment), args.timeout,
-                                 check=lambda: check_started(sup, programs))
-            if missing:
-                check_started(sup, programs)
-                raise ConfigError(f"running, but still waiting on {', '.join(sorted(missing))} "
+        missing: set[str] = set()
+        try:
+            wait_running(sup, programs, args.timeout)
+            if not args.no_wait:
+                missing = wait_alive(deployment, expected_alive(deployment), args.timeout,
+                                     check=lambda: check_started(sup, programs))
+                if missing:
+                    check_started(sup, programs)
+        except ConfigError as exc:
+            # A program that cannot start (a port in use, a bad device): the others would
+            # run without it, and its clients join whatever bus they reach, another
+            # stack's included. What this command started is stopped again.
+            left = "" if _stop_supervisor(sup) is None else (
+                "; supervisord did not stop: `zenav down` stops it")
+            raise ConfigError(f"{exc}; stopped what it had started{left}") from None
+        if missing:
+            raise ConfigError(f"running, but still waiting on {', '.join(sorted(missing))} "
                                   f"on the bus after {args.timeout:.0f} s without another "
                                   f"arriving (is the router at "
                                   f"{', '.join(deployment.transport.connect)} reachable?). "
@@ -131,19 +141,9 @@ def cmd_down(args: argparse.Namespace) -> int:
         return 0
     log = run_dir / "logs" / "supervisord.log"
     offset = log.stat().st_size if log.exists() else 0
-    unclean = []
-    try:
-        sup.stop_in_order()
-        sup.proxy().supervisor.shutdown()
-    except (OSError, xmlrpc.client.Fault) as exc:
-        print(f"zenav down: supervisord did not answer ({exc}); sending SIGTERM", file=sys.stderr)
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(pid, 15)
-    deadline = time.monotonic() + 30
-    while sup.pid() is not None and time.monotonic() < deadline:
-        time.sleep(0.05)
-    if sup.pid() is not None:
-        print(f"zenav down: supervisord (pid {pid}) still running after 30 s", file=sys.stderr)
+    problem = _stop_supervisor(sup, say="zenav down")
+    if problem is not None:
+        print(f"zenav down: {problem}", file=sys.stderr)
         return 1
     unclean = unclean_stops(log, offset)
     if unclean:
@@ -151,6 +151,31 @@ def cmd_down(args: argparse.Namespace) -> int:
         return 1
     print(f"zenav down: {name} stopped cleanly")
     return 0
+
+
+def _stop_supervisor(sup: Supervisor, say: str | None = None, timeout: float = 30.0
+                     ) -> str | None:
+    """Stop every program of ``sup`` in order, then supervisord itself (SIGTERM when it
+    does not answer, said on stderr after ``say``); None once it is gone, else the problem
+    (still running after ``timeout`` s)."""
+    pid = sup.pid()
+    if pid is None:
+        return None
+    try:
+        sup.stop_in_order()
+        sup.proxy().supervisor.shutdown()
+    except (OSError, xmlrpc.client.Fault) as exc:
+        if say is not None:
+            print(f"{say}: supervisord did not answer ({exc}); sending SIGTERM",
+                  file=sys.stderr)
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, 15)
+    deadline = time.monotonic() + timeout
+    while sup.pid() is not None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    if sup.pid() is not None:
+        return f"supervisord (pid {pid}) still running after {timeout:g} s"
+    return None
 
 
 OWN_OPTIONS = ("--run-dir", "--config")

@@ -32,9 +32,11 @@ def _reason(log: Path) -> str:
     except OSError:
         return "(no log)"
     for line in reversed(lines):
-        if line.startswith("zenav ") or " ERROR " in line or line.startswith(
+        if line.startswith("zenav ") or line.startswith(
                 ("Traceback", "ModuleNotFoundError", "ImportError")):
             return line
+        if " ERROR " in line:  # a log record: its text, without the time and level
+            return line.split(" ERROR ", 1)[1]
     return lines[-1] if lines else "(empty log)"
 
 
