@@ -43,6 +43,17 @@ LAYOUTS: tuple[Layout, ...] = ("circle", "square")
 
 TEST_SEED_OFFSET = 1000
 """CrowdNav seeds test case k with 1000 + k (the validation set's 1000 cases come first)."""
+LAST_CASE = 2**32 - 1 - TEST_SEED_OFFSET
+"""The last test case there is: its seed, 1000 + case, is the largest numpy's RandomState
+takes (32 bits)."""
+
+
+def check_cases(seed: int, cases: int) -> None:
+    """ValueError with one line unless test cases ``seed`` .. ``seed + cases - 1`` exist."""
+    if seed + cases - 1 > LAST_CASE:
+        raise ValueError(f"--seed {seed} with --cases {cases} runs to case {seed + cases - 1}, "
+                         f"beyond the last, {LAST_CASE} (a case's seed, 1000 + case, must fit "
+                         "in 32 bits)")
 HUMANS = 5
 CIRCLE_RADIUS = 4.0  # m
 SQUARE_WIDTH = 10.0  # m
@@ -109,8 +120,8 @@ def crowdnav_scenario(layout: Layout, case: int, *, visible: bool = False,
     """
     if layout not in LAYOUTS:
         raise ValueError(f"unknown layout {layout!r}; choose from {', '.join(LAYOUTS)}")
-    if case < 0:
-        raise ValueError(f"case must be >= 0 (got {case})")
+    if not 0 <= case <= LAST_CASE:
+        raise ValueError(f"case must be in 0..{LAST_CASE} (got {case})")
     rng = np.random.RandomState(TEST_SEED_OFFSET + case)
     humans = (circle_crossing if layout == "circle" else square_crossing)(rng)
     shift = WORLD / 2

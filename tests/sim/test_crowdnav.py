@@ -107,5 +107,8 @@ def test_same_case_same_scenario_and_cases_differ():
 def test_bad_arguments_are_named():
     with pytest.raises(ValueError, match="unknown layout 'ring'"):
         crowdnav_scenario("ring", 0)  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="case must be >= 0"):
+    with pytest.raises(ValueError, match=r"case must be in 0\.\.4294966295 \(got -1\)"):
         crowdnav_scenario("circle", -1)
+    crowdnav_scenario("circle", 2**32 - 1 - 1000)  # the last case there is: seed 2^32 - 1
+    with pytest.raises(ValueError, match=r"case must be in 0\.\.4294966295 \(got 4294966296\)"):
+        crowdnav_scenario("circle", 2**32 - 1000)

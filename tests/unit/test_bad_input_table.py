@@ -231,6 +231,14 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      2,
      "zenav up: {t}/d.yaml: transport: mode client needs a router to connect to: give "
      "connect: [ENDPOINT] (or --connect ENDPOINT)"),
+    ("bench bound past CrowdNav's last test case",
+     lambda t: ["bench", "bound", "--cases", "2", "--seed", "4294966295"], 2,
+     "zenav bench bound: --seed 4294966295 with --cases 2 runs to case 4294966296, beyond "
+     "the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"),
+    ("bench crowd past CrowdNav's last test case",
+     lambda t: ["bench", "crowd", "--seed", "4294967294", "--out", str(t / "o")], 2,
+     "zenav bench crowd: --seed 4294967294 with --cases 500 runs to case 4294967793, beyond "
+     "the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"),
     ("params from a file that sets one twice",
      lambda t: ["params", "planner", "--params",
                 str(a_text(t, "twice.yaml", "cruise_speed: 0.2\ncruise_speed: 0.3\n"))], 2,

@@ -41,6 +41,7 @@ from zenav.sim.crowdnav import (
     ROBOT_SPEED,
     TIME_LIMIT,
     Layout,
+    check_cases,
     crowdnav_scenario,
 )
 from zenav.sim.scenario import Scenario
@@ -192,6 +193,11 @@ def _command(args: argparse.Namespace) -> int:
             print(f"zenav bench bound: {name} must be >= {least} (got {value})",
                   file=sys.stderr)
             return 2
+    try:
+        check_cases(args.seed, args.cases)
+    except ValueError as exc:
+        print(f"zenav bench bound: {exc}", file=sys.stderr)
+        return 2
     started = time.monotonic()
     cases = range(args.seed, args.seed + args.cases)
     try:

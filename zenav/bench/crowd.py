@@ -38,6 +38,7 @@ from zenav.sim.crowdnav import (
     HUMAN_RADIUS,
     ROBOT_RADIUS,
     Layout,
+    check_cases,
     crowdnav_scenario,
 )
 from zenav.sim.scenario import dump_scenario
@@ -313,6 +314,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
 
 def _command(args: argparse.Namespace) -> int:
     try:
+        check_cases(args.seed, args.cases)
         run_crowd(words(args.planners), args.out, cases=args.cases, seed=args.seed,
                   settings=words(args.settings), jobs=args.jobs, engine=args.engine,
                   progress=not args.no_progress, reuse=args.reuse, verify=args.verify)
