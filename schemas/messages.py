@@ -292,10 +292,14 @@ class Track(BaseModel):
     visible: bool = Field(True, description="seen in this scan (False: predicted)")
 
 
+MAX_TRACKS = 400
+"""The most tracks one track list carries (the tracking service sends the nearest)."""
+
+
 class TrackList(Message):
     TYPE = "track_list"
     pose: Pose2D = Field(description="robot pose at scan time")
-    tracks: list[Track] = Field(max_length=400)
+    tracks: list[Track] = Field(max_length=MAX_TRACKS)
 
 
 # --- planning and control ------------------------------------------------------------

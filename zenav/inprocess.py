@@ -29,7 +29,7 @@ from zenav.services.planner.decide import Decision, Detour, Planner
 from zenav.services.planner.node import obstacles_of, scan_data
 from zenav.services.planner.params import Params as PlannerParams
 from zenav.services.planner.prediction import Assessment, Obstacle
-from zenav.services.tracking.node import track_messages
+from zenav.services.tracking.node import nearest_tracks, track_messages
 from zenav.services.tracking.params import TrackingParams
 from zenav.services.tracking.tracker import Tracker
 
@@ -121,7 +121,8 @@ class Pipeline:
         with self.clock.stage("perception"):
             clusters = self.perceiver.process(scan, pose)
         with self.clock.stage("tracking"):
-            tracks = track_messages(self.tracker.update(t, pose, clusters))
+            tracks = track_messages(nearest_tracks(self.tracker.update(t, pose, clusters),
+                                                   pose[0], pose[1]))
         track_list = TrackList(stamp=t, seq=seq, pose=Pose2D(x=pose[0], y=pose[1],
                                                              heading=pose[2]), tracks=tracks)
         obstacles = obstacles_of(track_list)
