@@ -408,7 +408,8 @@ def _command(args: argparse.Namespace) -> int:
 
 def add_command(kinds: Any) -> None:
     """``zenav bench nav`` (``kinds``: the subcommands of ``zenav bench``)."""
-    nav = kinds.add_parser("nav", help="planners on seeded random worlds through zenav run")
+    nav = kinds.add_parser("nav", help="planners on seeded random worlds (in-process "
+                           "engine, a sample re-run through the stack)")
     nav.add_argument("--planners", default="paper,vfh,dwa,apf",
                      help="comma-separated planner names (default paper,vfh,dwa,apf)")
     nav.add_argument("--worlds", type=int, default=5, help="worlds per family (default 5)")

@@ -14,6 +14,7 @@ import re
 import signal
 import sys
 import threading
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
@@ -23,10 +24,9 @@ from zenav.services.config import ConfigError, read_transport
 from zenav.services.runner import (
     add_log_level_argument,
     add_standby_argument,
-    add_transport_arguments,
+    endpoint,
     setup_logging,
     take_over,
-    transport_from_args,
 )
 from zenav.services.transport import TransportConfig, zenoh_problem
 
@@ -44,7 +44,7 @@ def router_transport(args: argparse.Namespace) -> TransportConfig:
     elif not args.listen and not args.connect:
         config = TransportConfig(mode="router", listen=[DEFAULT_LISTEN])
     else:
-        config = transport_from_args(args, None)
+        config = TransportConfig(mode="router", listen=args.listen, connect=args.connect)
     return config.model_copy(update={"mode": "router"})
 
 
@@ -106,6 +106,20 @@ def add_command(sub: Any) -> None:
     router = sub.add_parser("router", help="run a Zenoh router (the robot's, for off-board "
                             "services and monitors)")
     add_log_level_argument(router)
-    add_transport_arguments(router)
+    # A router's own transport options: it is always a router, and the services' loopback
+    # mesh (--mode, --base-port) is not its business.
+    group = router.add_argument_group("transport")
+    group.add_argument("--robot-id", default="robot0",
+                       help="robot id of its liveliness token (default robot0)")
+    group.add_argument("--transport", type=Path, metavar="FILE",
+                       help="YAML file of transport settings (a TransportConfig: listen, "
+                            "connect, ...; its mode is router whatever the file says)")
+    group.add_argument("--listen", action="append", default=[], type=endpoint,
+                       metavar="ENDPOINT",
+                       help="listen on this Zenoh endpoint (repeatable; default "
+                            f"{DEFAULT_LISTEN} when neither --listen nor --connect is given)")
+    group.add_argument("--connect", action="append", default=[], type=endpoint,
+                       metavar="ENDPOINT",
+                       help="connect to another router at this endpoint (repeatable)")
     add_standby_argument(router)
     router.set_defaults(func=main)
