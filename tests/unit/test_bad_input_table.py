@@ -239,6 +239,10 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["bench", "crowd", "--seed", "4294967294", "--out", str(t / "o")], 2,
      "zenav bench crowd: --seed 4294967294 with --cases 500 runs to case 4294967793, beyond "
      "the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"),
+    ("up --scenario a file that is not there",
+     lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
+                str(REPO / "deploy" / "stack.yaml"), "--scenario", str(t / "none.yaml")], 2,
+     "zenav up: --scenario: {t}/none.yaml: file not found"),
     ("params from a file that sets one twice",
      lambda t: ["params", "planner", "--params",
                 str(a_text(t, "twice.yaml", "cruise_speed: 0.2\ncruise_speed: 0.3\n"))], 2,

@@ -186,8 +186,9 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
 
         try:
             load_scenario(deployment.scenario)
-        except ScenarioError as exc:
-            raise ConfigError(f"{path}: scenario: {exc}") from None
+        except ScenarioError as exc:  # named where it was given: --scenario, or the file
+            where = "--scenario" if scenario is not None else f"{path}: scenario"
+            raise ConfigError(f"{where}: {exc}") from None
     for spec in deployment.services.values():
         spec.config = [(base / p).resolve() for p in spec.config]
     if deployment.security is not None:
