@@ -20,8 +20,8 @@ def add_command(sub: Any) -> None:
         description="Print every parameter of a service as YAML, each value followed by its "
                     "origin: default, profile, scenario, file or --set.")
     params.add_argument("name", help=f"service: {', '.join(SERVICE_ORDER)}")
-    params.add_argument("--planner", default="paper",
-                        help="planner implementation, for NAME planner (default paper)")
+    params.add_argument("--planner",
+                        help="planner implementation, for NAME planner only (default paper)")
     params.add_argument("--profile", default="zenav", metavar="NAME",
                         help="parameter profile laid over the defaults: zenav or paper")
     params.add_argument("--scenario", type=Path, metavar="FILE",
@@ -44,20 +44,28 @@ def run(args: argparse.Namespace) -> int:
     )
     from zenav.services.mission import scenario_layer
     from zenav.services.profiles import profile_layer
-    from zenav.services.runner import service_params
+    from zenav.services.runner import check_params, service_params
     from zenav.sim.scenario import ScenarioError, load_scenario
     from zenav.stackcmd import say_each
 
     try:
-        model = service_params(args.name, args.planner)
-        layers: list[Layer] = [profile_layer(args.profile, args.name, args.planner)]
+        if args.planner is not None and args.name != "planner":
+            raise ConfigError(f"--planner {args.planner}: only the planner service has "
+                              f"implementations to choose from, not {args.name}")
+        planner = args.planner or "paper"
+        model = service_params(args.name, planner)
+        layers: list[Layer] = [profile_layer(args.profile, args.name, planner)]
         if args.scenario is not None:
             scenario = load_scenario(args.scenario)
-            layers.append(scenario_layer(scenario, args.scenario, args.name, args.planner))
+            layers.append(scenario_layer(scenario, args.scenario, args.name, planner))
         layers += [file_layer(path) for path in args.params]
         layers += [assignment_layer(text) for text in args.set]
-        _, settings = resolve(model, layers)
-    except (ConfigError, ScenarioError) as exc:
+        values, settings = resolve(model, layers)
+        # What the service would refuse at start; a simulator not yet given its scenario
+        # is shown as it is (its scenario: null), not refused.
+        if getattr(values, "scenario", "") is not None:
+            check_params(args.name, values, planner)
+    except (ConfigError, ScenarioError, ValueError) as exc:
         say_each("zenav params", exc)  # one line per problem
         return 2
     title = f"{args.name}: every parameter, its value and its origin (zenav params {args.name})"

@@ -243,6 +243,13 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
                 str(REPO / "deploy" / "stack.yaml"), "--scenario", str(t / "none.yaml")], 2,
      "zenav up: --scenario: {t}/none.yaml: file not found"),
+    ("params of a simulator whose scenario is not there",
+     lambda t: ["params", "simulator", "--set", f"scenario={t / 'none.yaml'}"], 2,
+     "zenav params: {t}/none.yaml: file not found"),
+    ("params --planner for a service that is not the planner",
+     lambda t: ["params", "perception", "--planner", "vfh"], 2,
+     "zenav params: --planner vfh: only the planner service has implementations to choose "
+     "from, not perception"),
     ("params from a file that sets one twice",
      lambda t: ["params", "planner", "--params",
                 str(a_text(t, "twice.yaml", "cruise_speed: 0.2\ncruise_speed: 0.3\n"))], 2,
