@@ -165,14 +165,20 @@ def test_the_cell_index_is_the_floor_of_the_quotient() -> None:
     assert np.array_equal(out, np.floor(offsets / resolution).astype(np.int64))
 
 
-def test_the_map_looks_points_up_as_cell_of_and_inside_do() -> None:
-    """``blocked_at`` and ``lethal_at`` (compiled ``look_up``) against the numpy look-up
-    they replaced: points inside and beyond the grid, on cell edges, and nan."""
-    rng = np.random.default_rng(5)
+def scanned_map(rng: np.random.Generator) -> Costmap:
+    """A 4 x 3 m map at 0.1 m, seen once from (1, 1) by a 181-beam scan of random ranges."""
     cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
                  confirm=0.0, padding=1.0, max_size=30.0)
     cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
                        math.pi / 180, 8.0), 0.0)
+    return cm
+
+
+def test_the_map_looks_points_up_as_cell_of_and_inside_do() -> None:
+    """``blocked_at`` and ``lethal_at`` (compiled ``look_up``) against the numpy look-up
+    they replaced: points inside and beyond the grid, on cell edges, and nan."""
+    rng = np.random.default_rng(5)
+    cm = scanned_map(rng)
     edges = np.column_stack([np.arange(-12, 52) * 0.1, np.arange(-12, 52)[::-1] * 0.1])
     points = np.vstack([rng.uniform(-3.0, 8.0, (2000, 2)), edges,
                         [[np.nan, 1.0], [1.0, np.nan], [np.inf, 0.0]]])
@@ -240,10 +246,7 @@ def test_blocked_along_looks_up_the_points_of_path_points(seed: int) -> None:
     ``blocked_at`` of ``path_points``' points, ``any``: lines across a map with walls,
     into and beyond the grid, and of length 0."""
     rng = np.random.default_rng(seed)
-    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
-                 confirm=0.0, padding=1.0, max_size=30.0)
-    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
-                       math.pi / 180, 8.0), 0.0)
+    cm = scanned_map(rng)
     hits = 0
     for _ in range(50):
         start = rng.uniform(-2.0, 6.0, 2)
@@ -266,10 +269,7 @@ def test_blocked_along_from_far_away_looks_only_at_the_points_on_the_grid(seed: 
     ``blocked_at`` of all its points (those off the grid are free); one that starts 1e15 m
     away (a pose a bad message may carry) is answered without walking its 4e16 points."""
     rng = np.random.default_rng(1000 + seed)
-    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
-                 confirm=0.0, padding=1.0, max_size=30.0)
-    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
-                       math.pi / 180, 8.0), 0.0)
+    cm = scanned_map(rng)
     hits = 0
     for _ in range(40):
         bearing = rng.uniform(-math.pi, math.pi)
@@ -298,10 +298,7 @@ def test_blocked_rows_is_any_of_blocked_at_per_row(seed: int) -> None:
     """``blocked_rows`` (compiled ``look_up_rows``) is ``blocked_at`` of every point, any
     per row: rows of points inside and beyond the grid."""
     rng = np.random.default_rng(seed)
-    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
-                 confirm=0.0, padding=1.0, max_size=30.0)
-    cm.update(ScanData((1.0, 1.0, 0.2), rng.uniform(0.5, 4.0, 181), -math.pi / 2,
-                       math.pi / 180, 8.0), 0.0)
+    cm = scanned_map(rng)
     xs, ys = rng.uniform(-3.0, 8.0, (300, 12)), rng.uniform(-3.0, 8.0, (300, 12))
     want = cm.blocked_at(np.column_stack([xs.ravel(), ys.ravel()])).reshape(xs.shape)
     got = cm.blocked_rows(xs, ys)

@@ -63,6 +63,10 @@ def a_bag(tmp: Path) -> Path:
 
 Args = Callable[[Path], list[str]]
 
+NO_ROUTER = "mode client needs a router to connect to: give connect: [ENDPOINT] (or --connect "\
+    "ENDPOINT)"
+PAST_LAST_CASE = "beyond the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"
+
 BAD_INPUT: list[tuple[str, Args, int, str]] = [
     # (case, argv from a scratch folder, exit status, the first line of stderr)
     ("run --out an existing file",
@@ -218,27 +222,24 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      "give --as-robot ID to publish under another"),
     ("monitor as a client with no router to connect to",
      lambda t: ["monitor", "--transport", str(a_text(t, "client.yaml", "mode: client\n"))], 2,
-     "zenav monitor: {t}/client.yaml: mode client needs a router to connect to: give connect: "
-     "[ENDPOINT] (or --connect ENDPOINT)"),
+     "zenav monitor: {t}/client.yaml: " + NO_ROUTER),
     ("a service as a client with no router to connect to",
      lambda t: ["service", "tracking", "--transport",
                 str(a_text(t, "client.yaml", "mode: client\n"))], 2,
-     "zenav tracking: {t}/client.yaml: mode client needs a router to connect to: give "
-     "connect: [ENDPOINT] (or --connect ENDPOINT)"),
+     "zenav tracking: {t}/client.yaml: " + NO_ROUTER),
     ("up a deployment whose clients have no router to connect to",
      lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
                 str(a_text(t, "d.yaml", "name: d\ntransport: {mode: client}\nservices: {}\n"))],
      2,
-     "zenav up: {t}/d.yaml: transport: mode client needs a router to connect to: give "
-     "connect: [ENDPOINT] (or --connect ENDPOINT)"),
+     "zenav up: {t}/d.yaml: transport: " + NO_ROUTER),
     ("bench bound past CrowdNav's last test case",
      lambda t: ["bench", "bound", "--cases", "2", "--seed", "4294966295"], 2,
-     "zenav bench bound: --seed 4294966295 with --cases 2 runs to case 4294966296, beyond "
-     "the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"),
+     "zenav bench bound: --seed 4294966295 with --cases 2 runs to case 4294966296, "
+     + PAST_LAST_CASE),
     ("bench crowd past CrowdNav's last test case",
      lambda t: ["bench", "crowd", "--seed", "4294967294", "--out", str(t / "o")], 2,
-     "zenav bench crowd: --seed 4294967294 with --cases 500 runs to case 4294967793, beyond "
-     "the last, 4294966295 (a case's seed, 1000 + case, must fit in 32 bits)"),
+     "zenav bench crowd: --seed 4294967294 with --cases 500 runs to case 4294967793, "
+     + PAST_LAST_CASE),
     ("up --scenario a file that is not there",
      lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
                 str(REPO / "deploy" / "stack.yaml"), "--scenario", str(t / "none.yaml")], 2,
