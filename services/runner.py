@@ -37,6 +37,7 @@ from zenav.services.config import (
 )
 from zenav.services.inputs import OneLineParser
 from zenav.services.transport import (
+    NO_ROUTER,
     Bus,
     TransportConfig,
     ZenohBus,
@@ -223,8 +224,7 @@ def check_finds_a_router(config: TransportConfig, args: argparse.Namespace) -> N
     """ConfigError when ``config`` is a client that could never reach a router."""
     if config.finds_no_router():
         source = f"{args.transport}: " if args.transport is not None else ""
-        raise ConfigError(f"{source}mode client needs a router to connect to: give connect: "
-                          "[ENDPOINT] (or --connect ENDPOINT)")
+        raise ConfigError(f"{source}{NO_ROUTER}")
 
 
 def add_standby_argument(parser: argparse.ArgumentParser) -> None:

@@ -85,6 +85,11 @@ def zenoh_problem(exc: BaseException) -> str:
     return " ".join(_RUST_PLACE.sub("", str(exc)).split())
 
 
+NO_ROUTER = ("mode client needs a router to connect to: give connect: [ENDPOINT] (or --connect "
+             "ENDPOINT)")
+"""What is wrong with a transport that :meth:`TransportConfig.finds_no_router`."""
+
+
 class TransportConfig(BaseModel):
     """How a process joins the Zenoh network.
 
@@ -109,7 +114,7 @@ class TransportConfig(BaseModel):
 
     def finds_no_router(self) -> bool:
         """A client with nowhere to look for its router: no endpoint to connect to and
-        multicast scouting off. Its session could never open."""
+        multicast scouting off. Its session could never open (:data:`NO_ROUTER` says so)."""
         return (self.mode == "client" and not self.connect and not self.multicast_scouting
                 and "connect/endpoints" not in self.extra)
 

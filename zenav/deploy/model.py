@@ -20,7 +20,7 @@ from zenav.services.config import (
     read_yaml,
     resolve,
 )
-from zenav.services.transport import Endpoint, TransportConfig, check_endpoint
+from zenav.services.transport import NO_ROUTER, Endpoint, TransportConfig, check_endpoint
 from zenav.tooling import with_client_defaults
 
 DEFAULT_CONFIG = Path("deploy/stack.yaml")
@@ -210,8 +210,7 @@ def load_deployment(path: Path, overrides: Iterable[str] = (),
     if connect:
         deployment.transport = deployment.transport.model_copy(update={"connect": connect})
     if deployment.transport.finds_no_router():
-        raise ConfigError(f"{path}: transport: mode client needs a router to connect to: "
-                          "give connect: [ENDPOINT] (or --connect ENDPOINT)")
+        raise ConfigError(f"{path}: transport: {NO_ROUTER}")
     deployment.transport = with_client_defaults(deployment.transport)
     return deployment
 
