@@ -8,12 +8,14 @@ one machine never hear each other.
 
 from __future__ import annotations
 
+import fcntl
 import os
 import random
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -24,19 +26,69 @@ import yaml
 
 from zenav.services.config import SERVICE_ORDER, loopback_mesh
 
+PORT_LOCKS = Path(tempfile.gettempdir()) / "zenav-ports"
+"""One lock file per loopback port a stack of this machine has reserved."""
+
+_held: dict[int, list[int]] = {}  # base port -> open, locked lock files
+
 
 def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) -> int:
-    """A base port such that base..base+count-1 are free on loopback.
+    """A base port such that base..base+count-1 are free on loopback, reserved for this
+    process until ``release_port_block`` or its exit.
 
     Chosen below the usual ephemeral range (32768+) so outgoing connections do not take
-    them meanwhile.
+    them meanwhile. A free port is only free until someone binds it, and a stack's
+    services bind theirs a second or so after the block is chosen: two stacks started
+    at once could pick overlapping blocks, and one of them then fails with "address
+    already in use". So each port is also locked (``flock`` on a file in
+    ``PORT_LOCKS``) and a port another process holds is not chosen; the lock goes with
+    the process that holds it, even if it is killed.
     """
     rng = random.Random(os.getpid() ^ time.monotonic_ns())
     for _ in range(attempts):
         base = rng.randrange(20000, 32000 - count)
+        if base in _held:
+            continue
+        locks = _lock_ports(range(base, base + count))
+        if locks is None:
+            continue
         if loopback_ports_free(range(base, base + count)):
+            _held[base] = locks
             return base
+        _unlock(locks)
     raise RuntimeError("no free block of loopback ports found")
+
+
+def release_port_block(base: int) -> None:
+    """Let other stacks on this machine choose the block at ``base`` again."""
+    _unlock(_held.pop(base, []))
+
+
+def _lock_ports(ports: Iterable[int]) -> list[int] | None:
+    """Locks on every one of ``ports``, or None (and no lock) if another process holds
+    one. Where the lock directory cannot be used the reservation is skipped: the ports
+    are then only checked free, as before."""
+    locks: list[int] = []
+    try:
+        if not PORT_LOCKS.is_dir():
+            PORT_LOCKS.mkdir(exist_ok=True)
+            PORT_LOCKS.chmod(0o1777)  # shared by every user's stacks, like /tmp
+        for port in ports:
+            fd = os.open(PORT_LOCKS / str(port), os.O_RDONLY | os.O_CREAT, 0o644)
+            locks.append(fd)
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        _unlock(locks)
+        return None
+    except OSError:
+        _unlock(locks)
+        return []
+    return locks
+
+
+def _unlock(locks: list[int]) -> None:
+    for fd in locks:
+        os.close(fd)  # closing the file drops its lock
 
 
 def loopback_ports_free(ports: Iterable[int]) -> bool:
@@ -151,4 +203,5 @@ class Stack:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 codes[service] = proc.wait()
+        release_port_block(self.base_port)
         return codes
