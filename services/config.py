@@ -21,7 +21,7 @@ import yaml
 from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
-from zenav.services.inputs import AliasError, clipped, safe_load, shown, yaml_problem
+from zenav.services.inputs import AliasError, clipped, not_valid_yaml, safe_load, shown
 from zenav.services.transport import TransportConfig
 
 P = TypeVar("P", bound=BaseModel)
@@ -59,7 +59,7 @@ def read_yaml(path: Path, mapping: str = "parameter names to values") -> dict[st
     except AliasError as exc:
         raise ConfigError(f"{path}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({yaml_problem(exc)})") from None
+        raise ConfigError(f"{path}: {not_valid_yaml(exc)}") from None
     if data is None:
         return {}
     if not isinstance(data, dict):

@@ -114,12 +114,15 @@ def shown(value: object, limit: int = SHOWN_CHARS) -> str:
     return clipped(_REPR.repr(value), limit)
 
 
-def yaml_problem(exc: yaml.YAMLError) -> str:
-    """What is wrong with a YAML text, on one line: the problem and where."""
+def not_valid_yaml(exc: yaml.YAMLError) -> str:
+    """What is wrong with a YAML text, on one line, the same for every file zenav reads:
+    "not valid YAML (the problem (line L, column C))"."""
     if isinstance(exc, yaml.MarkedYAMLError) and exc.problem_mark is not None:
         mark = exc.problem_mark
-        return f"{exc.problem} (line {mark.line + 1}, column {mark.column + 1})"
-    return clipped(str(exc), 200)
+        problem = f"{exc.problem} (line {mark.line + 1}, column {mark.column + 1})"
+    else:
+        problem = clipped(str(exc), 200)
+    return f"not valid YAML ({problem})"
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -27,7 +27,7 @@ from pydantic import (
     model_validator,
 )
 
-from zenav.services.inputs import AliasError, BoundedLoader, safe_load, shown, yaml_problem
+from zenav.services.inputs import AliasError, BoundedLoader, not_valid_yaml, safe_load, shown
 from zenav.services.mission import WINDOW_CELLS, window_radius
 
 __all__ = [
@@ -425,7 +425,7 @@ def load_scenario(path: str | Path) -> Scenario:
     except AliasError as exc:
         raise ScenarioError(f"{source}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ScenarioError(f"{source}: YAML syntax error: {yaml_problem(exc)}") from None
+        raise ScenarioError(f"{source}: {not_valid_yaml(exc)}") from None
     return parse_scenario(data, source)
 
 

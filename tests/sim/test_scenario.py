@@ -299,13 +299,13 @@ def test_every_problem_is_reported_on_its_own_line(tmp_path: Path) -> None:
 
 def test_yaml_syntax_error_names_file_and_line(tmp_path: Path) -> None:
     message = load_error(write(tmp_path, "name: x\nworld: [1, 2\nrobot: {}\n"))
-    assert message.startswith("bad.yaml: YAML syntax error")
+    assert message.startswith("bad.yaml: not valid YAML (")
     assert "line 3" in message
 
 
 def test_duplicate_key_is_an_error(tmp_path: Path) -> None:
     message = load_error(write(tmp_path, SPEC_EXAMPLE + "seed: 3\n"))
-    assert message.startswith("bad.yaml: YAML syntax error: duplicate key 'seed'")
+    assert message.startswith("bad.yaml: not valid YAML (duplicate key 'seed'")
 
 
 def test_missing_file_is_named(tmp_path: Path) -> None:
