@@ -395,13 +395,18 @@ def _command(args: argparse.Namespace) -> int:
     from zenav.run import RunError
 
     profiles = PROFILES if args.profile == "both" else (args.profile,)
-    for flag, value, least in (("--jobs", args.parallel, 1), ("--verify", args.verify, 0)):
+    verify = DEFAULT_VERIFY if args.verify is None else args.verify
+    for flag, value, least in (("--jobs", args.parallel, 1), ("--verify", verify, 0)):
         if value < least:
             print(f"zenav paper: {flag} must be >= {least} (got {value})", file=sys.stderr)
             return 2
+    if args.verify is not None and args.engine != "inprocess":
+        print("zenav paper: --verify checks --engine inprocess against the stack; with "
+              "--engine stack every run is a stack run already", file=sys.stderr)
+        return 2
     try:
         report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
-                      reuse=args.reuse, engine=args.engine, verify=args.verify)
+                      reuse=args.reuse, engine=args.engine, verify=verify)
     except RunError as exc:
         print(f"zenav paper: {exc}", file=sys.stderr)
         return 1
@@ -426,7 +431,7 @@ def add_command(sub: Any) -> None:
     paper.add_argument("--engine", choices=ENGINES, default="stack",
                        help="stack (default): six processes over Zenoh per run; inprocess: "
                        "the same services in one process per run, worker processes in parallel")
-    paper.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
+    paper.add_argument("--verify", type=int, default=None,
                        help="with --engine inprocess: runs re-made through the stack and "
                        f"compared tick by tick (default {DEFAULT_VERIFY})")
     paper.set_defaults(func=_command)
