@@ -74,8 +74,8 @@ def read_transport(path: Path) -> TransportConfig:
     try:
         return TransportConfig.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError("\n".join(format_error(str(path), error)
-                                    for error in exc.errors(include_url=False))) from None
+        raise ConfigError("\n".join(dict.fromkeys(  # one line for a list short by two
+            format_error(str(path), error) for error in exc.errors(include_url=False)))) from None
 
 
 def parse_assignment(text: str) -> tuple[list[str], Any]:
@@ -133,11 +133,19 @@ def _non_finite_leaves(value: object, loc: tuple[str | int, ...]
 
 
 def format_error(source: str, error: ErrorDetails) -> str:
-    where = ".".join(str(p) for p in error["loc"]) or "(top level)"
+    loc = error["loc"]
+    if (error["type"] == "missing" and loc and isinstance(loc[-1], int)
+            and isinstance(error["input"], list | tuple)):
+        # A list too short: pydantic reports each absent item as a missing field.
+        parent = ".".join(str(p) for p in loc[:-1])
+        return f"{source}: {parent}: too few items (got {shown(error['input'])})"
+    where = ".".join(str(p) for p in loc) or "(top level)"
     # A check of our own (value_error) quotes the value itself where it helps.
     got = f" (got {shown(error['input'])})" if error["type"] not in ("missing",
                                                                      "value_error") else ""
     message = error["msg"].removeprefix("Value error, ")
+    if error["type"] == "too_long" and "max_length" in error.get("ctx", {}):
+        message = f"too many items, at most {error['ctx']['max_length']}"
     if error["type"] not in ("missing", "extra_forbidden") and non_finite(error["input"]):
         message = FINITE  # nan is not "not greater than 0": it is no number at all
     return f"{source}: {where}: {message}{got}"
@@ -196,7 +204,7 @@ def resolve(model: type[P], layers: list[Layer]) -> tuple[P, list[Setting]]:
             first = str(error["loc"][0]) if error["loc"] else ""
             source = set_by[first].source if first in set_by else everyone
             lines.append(format_error(source, error))
-        raise ConfigError("\n".join(lines)) from None
+        raise ConfigError("\n".join(dict.fromkeys(lines))) from None  # a short list: once
     # pydantic reads "inf" and "1e400" as floats; no parameter of ours may be infinite
     infinite = [format_error(set_by[str(loc[0])].source if str(loc[0]) in set_by else "code",
                              {"type": "finite_number", "loc": loc, "msg": FINITE,

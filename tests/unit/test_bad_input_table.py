@@ -98,6 +98,10 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("paper --verify below zero",
      lambda t: ["paper", "--verify", "-1", "--out", str(t / "out")], 2,
      "zenav paper: --verify must be >= 0 (got -1)"),
+    ("paper --verify with the stack engine",
+     lambda t: ["paper", "--verify", "5", "--out", str(t / "out")], 2,
+     "zenav paper: --verify checks --engine inprocess against the stack; with --engine stack "
+     "every run is a stack run already"),
     ("bench perf --out a folder under a file",
      lambda t: ["bench", "perf", "--out", str(a_file(t) / "x")], 2,
      "zenav bench perf: {t}/a-file/x: {t}/a-file is a file, not a folder"),
@@ -347,6 +351,13 @@ PARAMS_PROBLEMS: list[tuple[str, Callable[[Path], list[str]], list[str]]] = [
      lambda t: ["params", "perception", "--params", str(a_params_file(t))],
      ["zenav params: {t}/perception.yaml: lambda_: Input should be greater than 0 (got -1)",
       "zenav params: {t}/perception.yaml: nosuch: Extra inputs are not permitted (got 1)"]),
+    ("an empty list for three weights (one line, not one per missing item)",
+     lambda t: ["params", "planner", "--set", "kappa=[]"],
+     ["zenav params: --set kappa=[]: kappa: too few items (got [])"]),
+    ("four weights for three",
+     lambda t: ["params", "planner", "--set", "kappa=[1,2,3,4]"],
+     ["zenav params: --set kappa=[1,2,3,4]: kappa: too many items, at most 3 "
+      "(got [1, 2, 3, 4])"]),
 ]
 
 
