@@ -58,6 +58,8 @@ class Simulation:
             deque(maxlen=keep) for _ in self.crowd.ids]
         self._snapshot: tuple[int, WorldSnapshot] | None = None  # (tick, its obstacles)
         self._record(0.0)
+        if math.dist(robot.start, robot.goal) <= robot.goal_tolerance:
+            self.outcome = "reached"  # there already: the run ends at t = 0, as it starts
 
     @property
     def t(self) -> float:
