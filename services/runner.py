@@ -418,7 +418,7 @@ def main(name: str, argv: list[str] | None = None) -> int:
             check_lock(args.standby_lock)
     except (ConfigError, ValueError) as exc:
         for line in str(exc).splitlines():  # one line per problem, each naming the service
-            print(f"zenav {name}: {line}", file=sys.stderr)
+            print(f"{parser.prog}: {line}", file=sys.stderr)
         return 2
     # Its input known good, the service opens its session while it loads its modules (a
     # warm spare stays off the bus until it takes over).

@@ -200,7 +200,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      "zenav ctl: --run-dir: expected a path after it"),
     ("service --set an unknown parameter",
      lambda t: ["service", "perception", "--set", "nosuch=1"], 2,
-     "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
+     "zenav service perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"),
     ("bench bound --offsets not numbers", lambda t: ["bench", "bound", "--offsets", "left"], 2,
      "zenav bench bound: argument --offsets: offsets must be numbers in m, got 'left'"),
     ("bench bound --cases 0", lambda t: ["bench", "bound", "--cases", "0"], 2,
@@ -230,7 +230,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("a service as a client with no router to connect to",
      lambda t: ["service", "tracking", "--transport",
                 str(a_text(t, "client.yaml", "mode: client\n"))], 2,
-     "zenav tracking: {t}/client.yaml: " + NO_ROUTER),
+     "zenav service tracking: {t}/client.yaml: " + NO_ROUTER),
     ("up a deployment whose clients have no router to connect to",
      lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
                 str(a_text(t, "d.yaml", "name: d\ntransport: {mode: client}\nservices: {}\n"))],
@@ -381,8 +381,8 @@ def test_service_and_up_name_each_bad_set_on_its_own_line(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert zenav_main(["service", "perception", "--set", "nosuch=1", "--set", "lambda_=-1"]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        "zenav perception: --set lambda_=-1: lambda_: Input should be greater than 0 (got -1)",
-        "zenav perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]
+        "zenav service perception: --set lambda_=-1: lambda_: Input should be greater than 0 (got -1)",
+        "zenav service perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]
     assert zenav_main(["up", "--print", "--run-dir", str(tmp_path / "run"), "--config",
                        str(REPO / "deploy" / "stack.yaml"), "--set", "planner.nosuch=1",
                        "--set", "tracking.nosuch=2"]) == 2

@@ -92,7 +92,7 @@ def test_the_simulator_service_refuses_a_billion_laughs_scenario(
     path = tmp_path / "laughs.yaml"
     path.write_text(LAUGHS)
     assert service_main("simulator", ["--set", f"scenario={path}"]) == 2
-    assert one_line(capsys).startswith(f"zenav simulator: {path}: aliases expand")
+    assert one_line(capsys).startswith(f"zenav service simulator: {path}: aliases expand")
 
 
 def test_a_set_value_with_runaway_aliases_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
@@ -213,18 +213,18 @@ def test_log_levels_are_read_in_any_case() -> None:
 
 
 @pytest.mark.parametrize(("name", "argv", "line"), [
-    ("simulator", [], "zenav simulator: the simulator needs a scenario: --set scenario=FILE"),
+    ("simulator", [], "zenav service simulator: the simulator needs a scenario: --set scenario=FILE"),
     ("simulator", ["--set", "scenario={t}/neg.yaml"],
-     "zenav simulator: {t}/neg.yaml: robot.radius: must be > 0 (got -0.2)"),
+     "zenav service simulator: {t}/neg.yaml: robot.radius: must be > 0 (got -0.2)"),
     ("simulator", ["--set", "scenario={t}/none.yaml"],
-     "zenav simulator: {t}/none.yaml: file not found"),
+     "zenav service simulator: {t}/none.yaml: file not found"),
     ("planner", ["--standby-lock", "/proc/zenav/x/lock"],
-     "zenav planner: --standby-lock /proc/zenav/x/lock: under /proc, which is not a place "
+     "zenav service planner: --standby-lock /proc/zenav/x/lock: under /proc, which is not a place "
      "for output"),
     ("planner", ["--standby-lock", "{t}/neg.yaml/lock"],
-     "zenav planner: --standby-lock {t}/neg.yaml/lock: {t}/neg.yaml is a file, not a folder"),
+     "zenav service planner: --standby-lock {t}/neg.yaml/lock: {t}/neg.yaml is a file, not a folder"),
     ("planner", ["--standby-lock", "{t}"],
-     "zenav planner: --standby-lock {t}: is a folder, not a file"),
+     "zenav service planner: --standby-lock {t}: is a folder, not a file"),
 ], ids=["no-scenario", "bad-scenario", "missing-scenario", "standby-lock-in-proc",
         "standby-lock-under-a-file", "standby-lock-a-folder"])
 def test_a_service_refuses_its_bad_input_with_one_line_and_status_2(
@@ -303,7 +303,7 @@ def test_a_parameter_file_with_inf_is_refused(tmp_path: Path,
     path = tmp_path / "perception.yaml"
     path.write_text("lambda_: .inf\n")
     assert service_main("perception", ["--config", str(path)]) == 2
-    assert one_line(capsys) == (f"zenav perception: {path}: lambda_: must be a finite number "
+    assert one_line(capsys) == (f"zenav service perception: {path}: lambda_: must be a finite number "
                                 "(got inf)")
 
 
