@@ -213,7 +213,8 @@ def test_log_levels_are_read_in_any_case() -> None:
 
 
 @pytest.mark.parametrize(("name", "argv", "line"), [
-    ("simulator", [], "zenav service simulator: the simulator needs a scenario: --set scenario=FILE"),
+    ("simulator", [],
+     "zenav service simulator: the simulator needs a scenario: --set scenario=FILE"),
     ("simulator", ["--set", "scenario={t}/neg.yaml"],
      "zenav service simulator: {t}/neg.yaml: robot.radius: must be > 0 (got -0.2)"),
     ("simulator", ["--set", "scenario={t}/none.yaml"],
@@ -222,7 +223,8 @@ def test_log_levels_are_read_in_any_case() -> None:
      "zenav service planner: --standby-lock /proc/zenav/x/lock: under /proc, which is not a place "
      "for output"),
     ("planner", ["--standby-lock", "{t}/neg.yaml/lock"],
-     "zenav service planner: --standby-lock {t}/neg.yaml/lock: {t}/neg.yaml is a file, not a folder"),
+     "zenav service planner: --standby-lock {t}/neg.yaml/lock: {t}/neg.yaml is a file, not a "
+     "folder"),
     ("planner", ["--standby-lock", "{t}"],
      "zenav service planner: --standby-lock {t}: is a folder, not a file"),
 ], ids=["no-scenario", "bad-scenario", "missing-scenario", "standby-lock-in-proc",
@@ -303,8 +305,8 @@ def test_a_parameter_file_with_inf_is_refused(tmp_path: Path,
     path = tmp_path / "perception.yaml"
     path.write_text("lambda_: .inf\n")
     assert service_main("perception", ["--config", str(path)]) == 2
-    assert one_line(capsys) == (f"zenav service perception: {path}: lambda_: must be a finite number "
-                                "(got inf)")
+    assert one_line(capsys) == (f"zenav service perception: {path}: lambda_: must be a finite "
+                                "number (got inf)")
 
 
 # --- the benchmarks' numbers ---------------------------------------------------------
