@@ -38,6 +38,28 @@ DEFAULT_VERIFY = 3
 """In-process jobs re-run through the stack to show the two engines agree."""
 
 
+def add_verify_argument(parser: Any) -> None:
+    """``--verify K`` of the commands that run batches (``paper``, ``bench nav``,
+    ``bench crowd``); read it with ``verify_count``."""
+    parser.add_argument("--verify", type=int, default=None, metavar="K",
+                        help="with --engine inprocess: K in-process runs re-made through the "
+                        f"stack and compared tick by tick (default {DEFAULT_VERIFY})")
+
+
+def verify_count(engine: str, verify: int | None) -> int:
+    """How many runs to verify: ``--verify`` as given, or the default. ValueError (one
+    line) for a negative count, or a count given with the stack engine, whose runs are
+    all stack runs already (it used to be accepted there and do nothing)."""
+    if verify is None:
+        return DEFAULT_VERIFY
+    if verify < 0:
+        raise ValueError(f"--verify must be >= 0 (got {verify})")
+    if engine != "inprocess":
+        raise ValueError("--verify checks --engine inprocess against the stack; with "
+                         "--engine stack every run is a stack run already")
+    return verify
+
+
 def default_jobs() -> int:
     """Runs at a time unless told: the cores this process may use."""
     try:

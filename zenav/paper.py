@@ -21,7 +21,14 @@ import numpy as np
 import yaml
 
 from zenav import argtypes
-from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch
+from zenav.batch import (
+    DEFAULT_VERIFY,
+    Job,
+    add_verify_argument,
+    default_jobs,
+    run_batch,
+    verify_count,
+)
 from zenav.engine import ENGINES
 from zenav.services.mission import window_radius
 from zenav.sim import SCENARIO_DIR
@@ -395,14 +402,12 @@ def _command(args: argparse.Namespace) -> int:
     from zenav.run import RunError
 
     profiles = PROFILES if args.profile == "both" else (args.profile,)
-    verify = DEFAULT_VERIFY if args.verify is None else args.verify
-    for flag, value, least in (("--jobs", args.parallel, 1), ("--verify", verify, 0)):
-        if value < least:
-            print(f"zenav paper: {flag} must be >= {least} (got {value})", file=sys.stderr)
-            return 2
-    if args.verify is not None and args.engine != "inprocess":
-        print("zenav paper: --verify checks --engine inprocess against the stack; with "
-              "--engine stack every run is a stack run already", file=sys.stderr)
+    try:
+        if args.parallel < 1:
+            raise ValueError(f"--jobs must be >= 1 (got {args.parallel})")
+        verify = verify_count(args.engine, args.verify)
+    except ValueError as exc:
+        print(f"zenav paper: {exc}", file=sys.stderr)
         return 2
     try:
         report = main(args.out, quick=args.quick, parallel=args.parallel, profiles=profiles,
@@ -431,7 +436,5 @@ def add_command(sub: Any) -> None:
     paper.add_argument("--engine", choices=ENGINES, default="stack",
                        help="stack (default): six processes over Zenoh per run; inprocess: "
                        "the same services in one process per run, worker processes in parallel")
-    paper.add_argument("--verify", type=int, default=None,
-                       help="with --engine inprocess: runs re-made through the stack and "
-                       f"compared tick by tick (default {DEFAULT_VERIFY})")
+    add_verify_argument(paper)
     paper.set_defaults(func=_command)

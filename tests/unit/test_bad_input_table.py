@@ -102,6 +102,13 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
      lambda t: ["paper", "--verify", "5", "--out", str(t / "out")], 2,
      "zenav paper: --verify checks --engine inprocess against the stack; with --engine stack "
      "every run is a stack run already"),
+    ("bench crowd --verify with the stack engine",
+     lambda t: ["bench", "crowd", "--engine", "stack", "--verify", "2", "--out", str(t / "o")], 2,
+     "zenav bench crowd: --verify checks --engine inprocess against the stack; with --engine "
+     "stack every run is a stack run already"),
+    ("bench nav --verify below zero",
+     lambda t: ["bench", "nav", "--verify", "-1", "--out", str(t / "o")], 2,
+     "zenav bench nav: --verify must be >= 0 (got -1)"),
     ("bench perf --out a folder under a file",
      lambda t: ["bench", "perf", "--out", str(a_file(t) / "x")], 2,
      "zenav bench perf: {t}/a-file/x: {t}/a-file is a file, not a folder"),
@@ -381,7 +388,8 @@ def test_service_and_up_name_each_bad_set_on_its_own_line(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert zenav_main(["service", "perception", "--set", "nosuch=1", "--set", "lambda_=-1"]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        "zenav service perception: --set lambda_=-1: lambda_: Input should be greater than 0 (got -1)",
+        "zenav service perception: --set lambda_=-1: lambda_: Input should be greater than 0 "
+        "(got -1)",
         "zenav service perception: --set nosuch=1: nosuch: Extra inputs are not permitted (got 1)"]
     assert zenav_main(["up", "--print", "--run-dir", str(tmp_path / "run"), "--config",
                        str(REPO / "deploy" / "stack.yaml"), "--set", "planner.nosuch=1",

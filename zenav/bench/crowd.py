@@ -31,7 +31,15 @@ from typing import Any
 import numpy as np
 
 from zenav import argtypes
-from zenav.batch import DEFAULT_VERIFY, Job, Records, run_batch, verified_note
+from zenav.batch import (
+    DEFAULT_VERIFY,
+    Job,
+    Records,
+    add_verify_argument,
+    run_batch,
+    verified_note,
+    verify_count,
+)
 from zenav.bench.common import machine, words
 from zenav.sim.crowdnav import (
     DISCOMFORT,
@@ -212,7 +220,7 @@ def write_cases(settings: Sequence[str], cases: int, seed: int,
 
 
 def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: str,
-          jobs: int, verify: int = DEFAULT_VERIFY) -> None:
+          jobs: int) -> None:
     """Refuse bad arguments with one line naming the problem (ValueError)."""
     from zenav.services.runner import PLANNERS as KNOWN
 
@@ -230,8 +238,6 @@ def check(planners: Sequence[str], settings: Sequence[str], cases: int, engine: 
         raise ValueError(f"--cases must be >= 1 (got {cases})")
     if jobs < 1:
         raise ValueError(f"--jobs must be >= 1 (got {jobs})")
-    if verify < 0:
-        raise ValueError(f"--verify must be >= 0 (got {verify})")
 
 
 def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int = 0,
@@ -251,7 +257,7 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
         TimeRemainingColumn,
     )
 
-    check(planners, settings, cases, engine, jobs, verify)
+    check(planners, settings, cases, engine, jobs)
     out.mkdir(parents=True, exist_ok=True)
     written = write_cases(settings, cases, seed, out / "cases")
     job_list = [Job(f"{name}/{p}/{case}", path, out / "runs" / name / p / str(case), planner=p)
@@ -315,9 +321,10 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
 def _command(args: argparse.Namespace) -> int:
     try:
         check_cases(args.seed, args.cases)
+        verify = verify_count(args.engine, args.verify)
         run_crowd(words(args.planners), args.out, cases=args.cases, seed=args.seed,
                   settings=words(args.settings), jobs=args.jobs, engine=args.engine,
-                  progress=not args.no_progress, reuse=args.reuse, verify=args.verify)
+                  progress=not args.no_progress, reuse=args.reuse, verify=verify)
     except ValueError as exc:
         print(f"zenav bench crowd: {exc}", file=sys.stderr)
         return 2
@@ -345,9 +352,7 @@ def add_command(kinds: Any) -> None:
                        "inprocess: the services in one process per run, --verify cases made "
                        "again through the stack and compared; stack: every run through "
                        "zenav run's six processes)")
-    crowd.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
-                       help="in-process runs re-made through the stack and compared tick by "
-                       f"tick (default {DEFAULT_VERIFY})")
+    add_verify_argument(crowd)
     crowd.add_argument("--out", type=argtypes.path, default=Path("out/bench-crowd"),
                        help="directory for the cases, runs, crowd.md, crowd.png, crowd.json "
                        "(default out/bench-crowd)")

@@ -24,7 +24,15 @@ from pathlib import Path
 from typing import Any
 
 from zenav import argtypes
-from zenav.batch import DEFAULT_VERIFY, Job, default_jobs, run_batch, verified_note
+from zenav.batch import (
+    DEFAULT_VERIFY,
+    Job,
+    add_verify_argument,
+    default_jobs,
+    run_batch,
+    verified_note,
+    verify_count,
+)
 from zenav.bench.common import machine, words
 from zenav.engine import ENGINES
 from zenav.services.geometry import wrap_angle
@@ -336,8 +344,6 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
         raise ValueError(f"--worlds must be >= 1 (got {worlds})")
     if jobs < 1:
         raise ValueError(f"--jobs must be >= 1 (got {jobs})")
-    if verify < 0:
-        raise ValueError(f"--verify must be >= 0 (got {verify})")
     if fov_deg is not None and not (0 < fov_deg <= 360 and (2 * fov_deg).is_integer()):
         raise ValueError(f"--fov must be in (0, 360] in half degrees (got {fov_deg:g})")
     out.mkdir(parents=True, exist_ok=True)
@@ -396,9 +402,10 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
 
 def _command(args: argparse.Namespace) -> int:
     try:
+        verify = verify_count(args.engine, args.verify)
         run_nav(words(args.planners), args.worlds, args.seed, args.out,
                 families=words(args.families), jobs=args.jobs,
-                progress=not args.no_progress, engine=args.engine, verify=args.verify,
+                progress=not args.no_progress, engine=args.engine, verify=verify,
                 fov_deg=args.fov, reuse=args.reuse)
     except ValueError as exc:
         print(f"zenav bench nav: {exc}", file=sys.stderr)
@@ -423,9 +430,7 @@ def add_command(kinds: Any) -> None:
     nav.add_argument("--engine", choices=ENGINES, default="inprocess",
                      help="inprocess (default): the services in one process per run, "
                      "worker processes in parallel; stack: six processes over Zenoh per run")
-    nav.add_argument("--verify", type=int, default=DEFAULT_VERIFY,
-                     help=f"in-process runs re-made through the stack and compared tick by "
-                     f"tick (default {DEFAULT_VERIFY})")
+    add_verify_argument(nav)
     nav.add_argument("--out", type=argtypes.path, default=Path("out/bench-nav"),
                      help="directory for the worlds, runs, nav.md, nav.png, nav.json "
                      "(default out/bench-nav)")
