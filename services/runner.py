@@ -216,15 +216,10 @@ def transport_from_args(args: argparse.Namespace, service: str | None) -> Transp
         config = loopback_mesh(service, args.base_port)
     if args.mode is not None:
         config = config.model_copy(update={"mode": args.mode})
-    check_finds_a_router(config, args)
-    return config
-
-
-def check_finds_a_router(config: TransportConfig, args: argparse.Namespace) -> None:
-    """ConfigError when ``config`` is a client that could never reach a router."""
-    if config.finds_no_router():
+    if config.finds_no_router():  # a client that could never reach a router
         source = f"{args.transport}: " if args.transport is not None else ""
         raise ConfigError(f"{source}{NO_ROUTER}")
+    return config
 
 
 def add_standby_argument(parser: argparse.ArgumentParser) -> None:

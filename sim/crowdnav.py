@@ -47,13 +47,6 @@ LAST_CASE = 2**32 - 1 - TEST_SEED_OFFSET
 """The last test case there is: its seed, 1000 + case, is the largest numpy's RandomState
 takes (32 bits)."""
 
-
-def check_cases(seed: int, cases: int) -> None:
-    """ValueError with one line unless test cases ``seed`` .. ``seed + cases - 1`` exist."""
-    if seed + cases - 1 > LAST_CASE:
-        raise ValueError(f"--seed {seed} with --cases {cases} runs to case {seed + cases - 1}, "
-                         f"beyond the last, {LAST_CASE} (a case's seed, 1000 + case, must fit "
-                         "in 32 bits)")
 HUMANS = 5
 CIRCLE_RADIUS = 4.0  # m
 SQUARE_WIDTH = 10.0  # m
@@ -68,6 +61,14 @@ ROBOT_START = (0.0, -CIRCLE_RADIUS)
 ROBOT_GOAL = (0.0, CIRCLE_RADIUS)
 
 Agent = tuple[float, float, float, float, float]  # px, py, gx, gy, radius (CrowdNav frame)
+
+
+def check_cases(seed: int, cases: int) -> None:
+    """ValueError with one line unless test cases ``seed`` .. ``seed + cases - 1`` exist."""
+    if seed + cases - 1 > LAST_CASE:
+        raise ValueError(f"--seed {seed} with --cases {cases} runs to case {seed + cases - 1}, "
+                         f"beyond the last, {LAST_CASE} (a case's seed, 1000 + case, must fit "
+                         "in 32 bits)")
 
 
 def _far(x: float, y: float, px: float, py: float, min_dist: float) -> bool:

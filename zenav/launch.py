@@ -47,8 +47,6 @@ def free_port_block(count: int = len(SERVICE_ORDER) + 1, attempts: int = 200) ->
     rng = random.Random(os.getpid() ^ time.monotonic_ns())
     for _ in range(attempts):
         base = rng.randrange(20000, 32000 - count)
-        if base in _held:
-            continue
         locks = _lock_ports(range(base, base + count))
         if locks is None:
             continue

@@ -20,8 +20,8 @@ from collections.abc import Callable, Coroutine
 from typing import Any, TypeVar
 
 from zenav.argtypes import positive_float
-from zenav.services.config import ConfigError, loopback_mesh, read_transport, tool_port
-from zenav.services.runner import check_finds_a_router, transport_from_args
+from zenav.services.config import ConfigError, loopback_mesh, tool_port
+from zenav.services.runner import transport_from_args
 from zenav.services.transport import TransportConfig, ZenohBus, zenoh_problem
 
 log = logging.getLogger(__name__)
@@ -62,15 +62,10 @@ def tool_transport(args: argparse.Namespace) -> TransportConfig:
     A bad option or transport file is a ConfigError with one line per problem."""
     if args.connect and args.mode is None and args.transport is None:
         config = client_transport(list(args.connect))
-    elif args.transport is not None:
-        config = read_transport(args.transport)
-        if args.mode is not None:
-            config = config.model_copy(update={"mode": args.mode})
-        check_finds_a_router(config, args)
-        config = with_client_defaults(config)
     else:
         config = transport_from_args(args, None)
-        if not (args.listen or args.connect) and config.mode == "peer":
+        if (args.transport is None and not (args.listen or args.connect)
+                and config.mode == "peer"):
             config = on_the_mesh(config, args.base_port)
         config = with_client_defaults(config)
     return with_connect_timeout(config, getattr(args, "connect_timeout", CONNECT_TIMEOUT))

@@ -483,13 +483,13 @@ class Costmap:
         dx, dy = direction
         ox, oy = float(self.origin[0]), float(self.origin[1])
         if count > 1:
-            on_grid = _on_grid_steps(x, y, dx, dy, length / (count - 1), count,
-                                     (ox, oy), self.shape, self.resolution)
+            step = length / (count - 1)
+            on_grid = _on_grid_steps(x, y, dx, dy, step, count, (ox, oy), self.shape,
+                                     self.resolution)
             if on_grid is None:
                 return False
             first, last = on_grid
             if (first, last) != (0, count - 1):
-                step = length / (count - 1)
                 x, y = x + dx * step * first, y + dy * step * first
                 length, count = step * (last - first), last - first + 1
         return line_any(x, y, dx, dy, length, count, ox, oy, self.resolution,
