@@ -141,8 +141,8 @@ def appeared_at_contact(scenario: Scenario, record: dict[str, Any]) -> bool:
     """Whether the run ended in contact with an obstacle that appeared (its ``appear``
     time, above 0) less than one laser period before the contact: the first scan that
     could show it came with the contact or after it, so no planner had a scan to act
-    on. The random worlds' crowd movers appear where they will whatever the robot
-    does, now and then on top of it."""
+    on. A scenario's obstacle appears where its file puts it, whatever the robot has
+    done, so it can come down on the robot."""
     index = record.get("collided_with")
     if record.get("outcome") != "collision" or index is None:
         return False
