@@ -110,6 +110,7 @@ class Detour:
     obstacle: int
     letter: ScenarioLetter
     side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
+    kind: ObstacleKind = "new"  # the obstacle's type when the detour was chosen
 
 
 def should_be_seen(scan: ScanData, point: tuple[float, float], radius: float) -> bool:
@@ -752,7 +753,8 @@ class Planner:
             return None
         chosen = 1 if best.g > 0 else -1
         self.sides[threat.obstacle.id] = chosen
-        return Detour(np.asarray(best.end), threat.obstacle.id, threat.letter, chosen)
+        return Detour(np.asarray(best.end), threat.obstacle.id, threat.letter, chosen,
+                      threat.obstacle.kind)
 
     # -- the cycle ---------------------------------------------------------------------
 
@@ -932,7 +934,14 @@ class Planner:
                                   p.heading_gain, p.max_omega)
         obstacle = lead.obstacle.id if lead is not None else (
             self.detour.obstacle if self.detour is not None else None)
-        kind = lead.obstacle.kind if lead is not None else None
+        # An event names the obstacle's type whenever it names an obstacle: on a detour,
+        # its type now if it is still tracked, else its type when the detour was chosen.
+        kind: ObstacleKind | None = None
+        if lead is not None:
+            kind = lead.obstacle.kind
+        elif self.detour is not None:
+            kind = next((o.kind for o in obstacles if o.id == self.detour.obstacle),
+                        self.detour.kind)
         return Decision(v, omega, (tx, ty), letter, action, obstacle, kind, speed, tuple(notes))
 
     # -- the cycle, stage by stage -----------------------------------------------------
