@@ -42,5 +42,6 @@ def test_crowd_movers_are_in_place_from_the_start_clear_of_the_robot() -> None:
         assert len(movers) == 5
         for mover in movers:
             assert mover.appear == 0.0 and mover.velocity is not None
+            assert mover.radius is not None  # a disc
             gap = float(np.hypot(*(np.asarray(mover.center) - start)))
             assert gap - mover.radius - scenario.robot.radius >= 0.5, (seed, gap)
