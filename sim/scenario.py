@@ -381,13 +381,14 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
         if not (obstacle.is_static and forever):
             continue
         to_goal = obstacle.signed_distance(robot.goal, 0.0)
-        # The point itself inside is _placement's problem. Free but too close: the robot
-        # disc standing on the goal would overlap the obstacle, and the run would wander
-        # until its timeout.
-        if 0.0 <= to_goal < robot.radius:
-            problems.append((("robot", "goal"), f"unreachable: the robot disc (radius "
-                             f"{robot.radius:g} m) at the goal overlaps static obstacles[{i}] "
-                             f"({obstacle.shape}, {to_goal:.3g} m from the goal)"))
+        # The point itself inside is _placement's problem. Free but so close that the
+        # robot's centre cannot come within goal_tolerance of it without its disc
+        # overlapping the obstacle: no run could reach it.
+        if to_goal >= 0.0 and to_goal + robot.goal_tolerance <= robot.radius:
+            problems.append((("robot", "goal"), f"unreachable: static obstacles[{i}] "
+                             f"({obstacle.shape}) is {to_goal:.3g} m from the goal, and the "
+                             f"robot disc (radius {robot.radius:g} m) cannot come within "
+                             f"goal_tolerance ({robot.goal_tolerance:g} m) of it"))
     return problems
 
 

@@ -54,6 +54,7 @@ from zenav.services.planner.global_path import (
     plan_path,
     point_at,
     project,
+    settle_point,
 )
 from zenav.services.planner.morphin import Mover, cells_on_segment, choose_detour
 from zenav.services.planner.params import Params
@@ -79,6 +80,13 @@ wall by ``walked_into``."""
 SPEED_GAP = 0.5
 """The longest time between two poses that the driven speed is measured over, s (five
 scans at 10 Hz)."""
+
+SETTLE_REACH = 0.75
+"""How far from the goal, as a fraction of ``goal_tolerance``, the stop may move off a
+wall with the comfortable clearance (``Planner.settle_goal``): the rest of the
+tolerance is the arrival's own room."""
+SETTLE_REACH_CLOSE = 0.9
+"""The same with the close clearance, the last resort before driving at the goal."""
 
 
 @dataclass(frozen=True)
@@ -146,7 +154,10 @@ class Planner:
 
     def __init__(self, params: Params) -> None:
         self.p = params
-        self.goal = np.asarray(params.goal, dtype=np.float64)
+        self.mission_goal = np.asarray(params.goal, dtype=np.float64)  # the run's goal
+        # Where the robot stops: the goal, or beside it when it lies too close to what
+        # the map holds (``settle_goal``).
+        self.goal = self.mission_goal.copy()
         self.start: Vec | None = (
             None if params.start is None else np.asarray(params.start, dtype=np.float64)
         )
@@ -978,13 +989,14 @@ class Planner:
             self._set_path(np.vstack([self.start, self.goal]), "start")
         self._remember_trail(robot)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        if float(np.hypot(*(self.goal - robot))) <= p.arrival_distance():
+        if float(np.hypot(*(self.goal - robot))) <= self.arrival_radius():
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
         if self.recovery.unreachable:
             return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
 
         self.update_map(pose, obstacles, scan, stamp)
+        self.settle_goal(robot)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
         if (decision is not None and decision.action in YIELDING
@@ -1450,6 +1462,42 @@ class Planner:
         s0, _ = project(self.path, robot, self.lengths)
         at = first_blocked(self.costmap, self.path, s0, p.map_resolution, self.lengths)
         return at is not None and at < s0 + p.window_radius
+
+    def arrival_radius(self) -> float:
+        """How close to ``goal`` the robot stops for good: ``arrival_distance`` at the
+        run's own goal; beside it (``settle_goal``), what keeps the stop within the
+        goal's tolerance, with a hundredth of it to spare."""
+        p = self.p
+        off = float(np.hypot(*(self.goal - self.mission_goal)))
+        if off < 1e-9:
+            return p.arrival_distance()
+        return min(p.arrival_distance(), p.goal_tolerance * 0.99 - off)
+
+    def settle_goal(self, robot: Vec) -> None:
+        """Within the window of the goal, move the point the robot stops at off what
+        the map holds there (``settle_point``): first within ``SETTLE_REACH`` of the
+        tolerance, clear by the robot's radius plus half ``safety_margin``; failing that,
+        within ``SETTLE_REACH_CLOSE`` of it, clear by the radius alone. The global
+        path's end moves with it, and it moves back to the goal when the map clears.
+        Without a map, or out of the window, the goal stays where it is."""
+        p = self.p
+        if self.costmap is None or not p.use_map:
+            return
+        if float(np.hypot(*(self.mission_goal - robot))) > p.window_radius:
+            return
+        aim = settle_point(self.costmap, self.mission_goal, robot,
+                           p.robot_radius + p.safety_margin / 2,
+                           SETTLE_REACH * p.goal_tolerance)
+        if aim is self.mission_goal or np.array_equal(aim, self.mission_goal):
+            aim = settle_point(self.costmap, self.mission_goal, robot, p.robot_radius,
+                               SETTLE_REACH_CLOSE * p.goal_tolerance)
+        if float(np.hypot(*(aim - self.goal))) < 1e-9:
+            return
+        self.goal = np.asarray(aim, dtype=np.float64)
+        if self.path is not None and len(self.path) >= 2:
+            path = self.path.copy()
+            path[-1] = self.goal
+            self._set_path(path, "goal settled")
 
     def update_path(self, robot: Vec, stamp: float) -> None:
         """Plan the global path on the map when it is needed (see ``replan_reason``)."""

@@ -67,7 +67,7 @@ def test_there_is_a_scenario_for_every_class():
                    "corridor-sealed-head-on", "hairpin", "slalom", "room-door-behind",
                    "door-two-way", "two-rooms", "s-bend", "doorway-stopper", "start-at-wall",
                    "corridor-overtaker", "blind-overtaker", "posts", "mover-stops",
-                   "facing-away"):
+                   "facing-away", "goal-beside-wall"):
         assert any(needed in name for name in names), needed
 
 
@@ -79,7 +79,9 @@ def test_class_scenario_is_reached_without_contact(path, records):
     last = record["trajectory"][-1]
     assert math.dist(last[1:3], scenario.robot.goal) <= scenario.robot.goal_tolerance + 1e-6
     assert ground_truth_clearance(path, record) > 0.0
-    assert record["path"][-1] == pytest.approx(list(scenario.robot.goal))
+    # The path ends at the goal, or beside it when the goal lies too close to a wall for
+    # the robot disc (``settle_point``), within the tolerance.
+    assert math.dist(record["path"][-1], scenario.robot.goal) < scenario.robot.goal_tolerance
 
 
 def test_the_appearing_box_is_never_taken_for_a_mover(records):

@@ -18,6 +18,7 @@ from zenav.services.planner.global_path import (
     plan_path,
     point_at,
     project,
+    settle_point,
     visible,
 )
 
@@ -225,3 +226,60 @@ def test_point_at_is_the_numpy_point_to_the_bit(seed: int) -> None:
             want = numpy_point_at(points, s).tobytes()
             assert point_at(points, s).tobytes() == want
             assert point_at(points, s, lengths).tobytes() == want
+
+
+def cell_square_gap(cm: Costmap, point: np.ndarray) -> float:
+    """Distance from ``point`` to the nearest occupied cell's square, cell by cell."""
+    best = math.inf
+    for i, j in np.argwhere(cm.lethal_grid()):
+        x0, y0 = cm.origin + np.array([i, j]) * cm.resolution
+        dx = max(x0 - point[0], 0.0, point[0] - (x0 + cm.resolution))
+        dy = max(y0 - point[1], 0.0, point[1] - (y0 + cm.resolution))
+        best = min(best, math.hypot(dx, dy))
+    return best
+
+
+def test_a_goal_clear_of_the_map_is_where_the_robot_stops() -> None:
+    cm = mapped([(5.0, 2.0, 5.5, 3.0)], stamps=(0.0, 1.5))
+    assert np.array_equal(settle_point(cm, GOAL, START, 0.25, 0.2), GOAL)
+
+
+def test_a_goal_beside_a_wall_settles_on_the_free_side_within_reach() -> None:
+    """The wall's face is 0.1 m beyond the goal: the robot disc (0.2 m) cannot stand on
+    the goal, and the point it stops at instead is clear of the wall's cells by the
+    clearance, within reach of the goal, on the robot's side."""
+    cm = mapped([(8.1, 2.0, 9.0, 6.0)], poses=((3.0, 4.0, 0.0),))
+    assert cell_square_gap(cm, GOAL) < 0.2
+    aim = settle_point(cm, GOAL, np.array([3.0, 4.0]), 0.2, 0.225)
+    assert not np.array_equal(aim, GOAL)
+    assert float(np.hypot(*(aim - GOAL))) <= 0.225 + 1e-9
+    assert cell_square_gap(cm, aim) >= 0.2
+    assert aim[0] + 0.2 <= 8.1  # the disc there clears the true face too
+    # Too far to find such a point: the goal stays.
+    assert np.array_equal(settle_point(cm, GOAL, np.array([3.0, 4.0]), 0.2, 0.05), GOAL)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_settled_points_are_clear_and_within_reach_whatever_the_wall(seed: int) -> None:
+    """A wall at a random side and distance of the goal (0.0-0.3 m from it): a point
+    that differs from the goal is clear by the clearance and within reach, and the one
+    returned is on the nearest ring that has a clear point."""
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, 2 * math.pi)
+    face = rng.uniform(0.0, 0.3)
+    centre = GOAL + (face + 0.25) * np.array([math.cos(angle), math.sin(angle)])
+    box = (centre[0] - 0.25, centre[1] - 0.25, centre[0] + 0.25, centre[1] + 0.25)
+    robot = GOAL - 3.0 * np.array([math.cos(angle), math.sin(angle)])
+    cm = mapped([box], poses=((*robot, angle),))
+    aim = settle_point(cm, GOAL, robot, 0.2, 0.25)
+    if np.array_equal(aim, GOAL):
+        assert cell_square_gap(cm, GOAL) >= 0.2 or all(
+            cell_square_gap(cm, GOAL + r * np.array([math.cos(a), math.sin(a)])) < 0.2
+            for r in np.arange(0.05, 0.25 + 1e-9, 0.05)
+            for a in np.linspace(0, 2 * math.pi, 36, endpoint=False))
+    else:
+        reach = float(np.hypot(*(aim - GOAL)))
+        assert reach <= 0.25 + 1e-9 and cell_square_gap(cm, aim) >= 0.2
+        for r in np.arange(0.05, reach - 1e-6, 0.05):  # no nearer ring has a clear point
+            assert all(cell_square_gap(cm, GOAL + r * np.array([math.cos(a), math.sin(a)]))
+                       < 0.2 for a in np.linspace(0, 2 * math.pi, 36, endpoint=False))

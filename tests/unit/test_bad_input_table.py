@@ -188,11 +188,12 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("bench crowd --seed below zero",
      lambda t: ["bench", "crowd", "--seed", "-1", "--out", str(t / "o")], 2,
      "zenav bench crowd: argument --seed: must be >= 0 (got -1)"),
-    ("run a goal the robot disc cannot stand on",
-     lambda t: ["run", str(scenario_with(t, "goal", obstacles=[
+    ("run a goal the robot disc cannot come within the tolerance of",
+     lambda t: ["run", str(scenario_with(t, "goal", robot__goal_tolerance=0.05, obstacles=[
          {"shape": "box", "center": [8.35, 3.0], "size": [0.5, 0.5]}])), "--out", str(t / "o")],
-     2, "zenav run: {t}/goal.yaml: robot.goal: unreachable: the robot disc (radius 0.2 m) "
-     "at the goal overlaps static obstacles[0] (box, 0.1 m from the goal)"),
+     2, "zenav run: {t}/goal.yaml: robot.goal: unreachable: static obstacles[0] (box) is "
+     "0.1 m from the goal, and the robot disc (radius 0.2 m) cannot come within "
+     "goal_tolerance (0.05 m) of it"),
     ("up --set an unknown parameter",
      lambda t: ["up", "--print", "--run-dir", str(t / "run"), "--config",
                 str(REPO / "deploy" / "stack.yaml"), "--set", "planner.nosuch=1"], 2,
