@@ -618,7 +618,7 @@ class Planner:
             x=pose[0], y=pose[1], heading=pose[2], speed=self.speed_now,
             radius=p.robot_radius, max_speed=p.max_speed, max_omega=p.max_omega,
             heading_gain=p.heading_gain, accel=p.accel, decel=p.decel,
-            goal=(float(self.goal[0]), float(self.goal[1])), arrive_within=p.arrival_distance())
+            goal=(float(self.goal[0]), float(self.goal[1])), arrive_within=self.arrival_radius())
         group = safety.Movers(
             np.array([o.position for o in movers], dtype=np.float64).reshape(-1, 2),
             np.array([o.velocity for o in movers], dtype=np.float64).reshape(-1, 2),
