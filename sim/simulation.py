@@ -16,6 +16,7 @@ from zenav.schemas.messages import (
     Pose2D,
     RunResult,
 )
+from zenav.services.geometry import wrap_angle
 from zenav.sim.agents import Crowd, RobotMotion
 from zenav.sim.contact import clearance, first_contact
 from zenav.sim.kinematics import RobotState, step_robot
@@ -158,13 +159,17 @@ class Simulation:
                 agents_at_hit = piece.disc_centers_at(contact[0])
         if contact is not None:
             t_hit, index = contact
+            # The whole state at the contact, as the record's last row says it: each
+            # value between the tick's two ends in the same proportion (the heading the
+            # short way round).
             frac = (t_hit - t0) / (t1 - t0) if t1 > t0 else 0.0
+            turned = wrap_angle(after.heading - before.heading)
             self.state = RobotState(
                 before.x + frac * (after.x - before.x),
                 before.y + frac * (after.y - before.y),
-                after.heading,
-                after.v,
-                after.omega,
+                wrap_angle(before.heading + frac * turned),
+                before.v + frac * (after.v - before.v),
+                before.omega + frac * (after.omega - before.omega),
             )
             self.path_length += frac * math.dist(p0, p1)
             self.tick += 1
