@@ -1488,12 +1488,12 @@ class Planner:
         aim = settle_point(self.costmap, self.mission_goal, robot,
                            p.robot_radius + p.safety_margin / 2,
                            SETTLE_REACH * p.goal_tolerance)
-        if aim is self.mission_goal or np.array_equal(aim, self.mission_goal):
+        if np.array_equal(aim, self.mission_goal):  # none clear with the margin
             aim = settle_point(self.costmap, self.mission_goal, robot, p.robot_radius,
                                SETTLE_REACH_CLOSE * p.goal_tolerance)
         if float(np.hypot(*(aim - self.goal))) < 1e-9:
             return
-        self.goal = np.asarray(aim, dtype=np.float64)
+        self.goal = aim
         if self.path is not None and len(self.path) >= 2:
             path = self.path.copy()
             path[-1] = self.goal

@@ -193,7 +193,6 @@ def plan_path(costmap: Costmap, start: Vec, goal: Vec, reason: str = "") -> Glob
     return GlobalPlan(points, length, reason)
 
 
-
 SETTLE_BEARINGS = 36
 """Points looked at on each ring round the goal by ``settle_point`` (every 10 degrees)."""
 
