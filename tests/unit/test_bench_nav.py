@@ -66,9 +66,17 @@ def test_a_timeout_standing_where_a_way_existed_is_stuck_and_fails_the_goal() ->
     (paper,), families = summarise(records, ["paper"], lambda name: name != "static-1")
     assert paper.stuck == ["crowd-1"]
     line = goal_lines([paper], families)
-    assert "stood still: 1 (crowd-1)" in line
-    assert "NOT met" in line
-    assert "short: crowd 0 %, static 50 %, mixed 0 %" in line
+    assert "stood still: 1 (crowd-1) (NOT met)." in line
+    assert "short: crowd 0 %, static 50 %, mixed 0 %) (NOT met);" in line
+
+
+def test_each_half_of_the_goal_has_its_own_verdict() -> None:
+    # One family short, nobody stuck: the success half fails, the standing half holds.
+    records = [record("crowd-1", "reached", standing_from(30.0, 31.0)),
+               record("crowd-2", "collision", standing_from(30.0, 31.0))]
+    (paper,), families = summarise(records, ["paper"])
+    line = goal_lines([paper], families)
+    assert "(short: crowd 50 %) (NOT met); stood still: 0 (met)." in line
 
 
 def test_the_goal_is_met_when_every_family_reaches_the_target() -> None:
@@ -76,7 +84,9 @@ def test_the_goal_is_met_when_every_family_reaches_the_target() -> None:
                for f in ("static", "crowd") for k in range(3)]
     (paper,), families = summarise(records, ["paper"])
     assert paper.stuck == []
-    assert goal_lines([paper], families).endswith("stood still: 0 (met).")
+    line = goal_lines([paper], families)
+    assert "lowest family static 100 % (met);" in line
+    assert line.endswith("stood still: 0 (met).")
 
 
 def walker_world(velocity: tuple[float, float], start: float = -3.0) -> Scenario:

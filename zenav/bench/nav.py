@@ -271,16 +271,19 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
     rates = {f: cell["paper/ok"] / cell["paper/n"] for f, cell in families.items()
              if cell.get("paper/n")}
     short = [f"{f} {100 * r:.0f} %" for f, r in rates.items() if r < TARGET_SUCCESS]
-    met = bool(rates) and not short and not paper.stuck
+    # Each half of the goal carries its own verdict: one verdict after the second half
+    # read as if it judged that half alone.
+    success_met = bool(rates) and not short
     lines = [f"Goal: paper planner ≥ {100 * TARGET_SUCCESS:.0f} % success on every family, "
              f"and no run ending with the robot standing for more than {STILL_LIMIT:g} s "
              f"while a way existed — lowest family "
              + (f"{min(rates, key=lambda f: rates[f])} {100 * min(rates.values()):.0f} %"
                 if rates else "—")
              + (f" (short: {', '.join(short)})" if short else "")
+             + f" ({'met' if success_met else 'NOT met'})"
              + f"; stood still: {len(paper.stuck)}"
              + (f" ({', '.join(paper.stuck)})" if paper.stuck else "")
-             + f" ({'met' if met else 'NOT met'})."]
+             + f" ({'NOT met' if paper.stuck else 'met'})."]
     if paper.collisions:
         lines.append("Collisions no scan could have warned of (never in the laser's field "
                      "of view, or appeared at the contact): "
