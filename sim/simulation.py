@@ -64,7 +64,9 @@ class Simulation:
 
     @property
     def t(self) -> float:
-        return round(self.tick * self.dt, 9)
+        """Simulated time, s: ``tick`` ticks, and never past the scenario's duration (the
+        last tick is cut short there when the duration is not a whole number of ticks)."""
+        return min(round(self.tick * self.dt, 9), self.scenario.duration)
 
     def scan_due(self) -> bool:
         return self.tick % self.ticks_per_scan == 0
@@ -125,15 +127,22 @@ class Simulation:
         self.min_clearance = min(self.min_clearance, gap)
 
     def step(self, v: float, omega: float) -> None:
-        """Drive for one tick with the commanded velocities; set ``outcome`` if the run ends."""
+        """Drive for one tick with the commanded velocities; set ``outcome`` if the run ends.
+        A tick that would run past the scenario's duration ends at it: the run's timeout
+        comes at ``duration`` exactly, as the run record says."""
         robot = self.scenario.robot
         t0 = self.t
+        t1 = round((self.tick + 1) * self.dt, 9)
+        dt = self.dt
+        if t1 > self.scenario.duration:
+            t1 = self.scenario.duration
+            dt = t1 - t0
         before = self.state
         after = step_robot(
             before,
             v,
             omega,
-            self.dt,
+            dt,
             v_max=robot.effective_max_speed,
             accel=self.params.base_accel,
             decel=self.params.base_decel,
@@ -141,7 +150,6 @@ class Simulation:
             alpha_accel=self.params.base_angular_accel,
             alpha_decel=self.params.base_angular_accel,
         )
-        t1 = round((self.tick + 1) * self.dt, 9)
         p0, p1 = (before.x, before.y), (after.x, after.y)
         contact = first_contact(p0, p1, robot.radius, self.world, t0, t1)
         agents_at_hit: np.ndarray | None = None
@@ -183,7 +191,7 @@ class Simulation:
         self._record(self.t)
         if math.dist(p1, tuple(self.goal)) <= robot.goal_tolerance:
             self.outcome = "reached"
-        elif self.t >= self.scenario.duration - 1e-9:
+        elif self.t >= self.scenario.duration:
             self.outcome = "timeout"
 
     def odometry(self, seq: int) -> Odometry:
