@@ -299,6 +299,47 @@ async def wait_for_event(event: asyncio.Event, timeout: float | None) -> bool:
     return True
 
 
+QUIET_NOTE_AFTER = 3.0
+"""s of hearing nothing of the robot after which a tool says on stderr where to look."""
+
+
+def quiet_note(command: str, transport: TransportConfig, robot_id: str,
+               after: float = QUIET_NOTE_AFTER) -> str:
+    """The one line a tool prints when it has heard nothing of ``robot_id`` for ``after``
+    s. On the loopback mesh (a tool's default, where ``zenav run`` puts its services) the
+    usual cause is a stack started with ``zenav up``: its services talk only through its
+    router, so a tool that does not connect to that router hears none of them."""
+    head = f"zenav {command}: nothing heard from {robot_id} in {after:g} s"
+    if isinstance(transport, MeshTool):
+        return (f"{head} on the loopback mesh, where `zenav run` puts its services; a stack "
+                "started with `zenav up` is reached through its router: --connect "
+                "tcp/127.0.0.1:7447 (its default)")
+    if transport.mode == "client":
+        return (f"{head} through the router {router_place(transport)}: are the services "
+                "up and joined to it, with this --robot-id?")
+    return f"{head}: are the services up on this transport, with this --robot-id?"
+
+
+class Heard:
+    """Whether a tool has heard anything of its robot yet: a message, or a liveliness token
+    other than its own. Marked from any thread."""
+
+    def __init__(self) -> None:
+        self.anything = False
+
+    def mark(self) -> None:
+        self.anything = True
+
+
+async def note_if_quiet(heard: Heard, stop: asyncio.Event, line: str,
+                        after: float = QUIET_NOTE_AFTER) -> None:
+    """Print ``line`` on stderr, once, if nothing is heard within ``after`` s of the call
+    and the tool is not stopped first. Run as a task beside the tool's own work, so a
+    tool that hears nothing says why instead of showing an empty view without a word."""
+    if not await wait_for_event(stop, after) and not heard.anything:
+        print(line, file=sys.stderr, flush=True)
+
+
 SampleCallback = Callable[[str, bytes, int], None]
 """Called on the asyncio loop with (key, payload, wall-clock receive time in ns)."""
 

@@ -59,13 +59,14 @@ def test_the_monitor_shows_the_global_path_and_the_map_of_a_live_stack(tmp_path:
         first = monitor.event("path", 60)
         snap = monitor.state("a second path and a map with the wall", planned_again, 90)
         recorder.send_signal(signal.SIGINT)
-        recorder.communicate(timeout=15)
+        said, _ = recorder.communicate(timeout=15)
     finally:
         if recorder is not None and recorder.poll() is None:
             recorder.kill()
         if monitor is not None:
             monitor.stop()
         stack.cleanup()
+    assert "nothing heard" not in said, said  # it heard the stack through the router
     assert first["reason"] == "start" and first["waypoints"] == 2
     assert first["length"] == pytest.approx(6.0, abs=0.01)  # (2, 3) to (8, 3)
     path, occupancy = snap["path"], snap["map"]

@@ -82,6 +82,20 @@ def test_a_tool_with_a_dead_peer_honours_its_duration(tool: str, tmp_path: Path)
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.parametrize("tool", ["monitor", "record", "foxglove"])
+def test_a_tool_that_hears_nothing_says_where_to_look(tool: str, tmp_path: Path) -> None:
+    # A loopback mesh no service is on: the note says that a stack started with
+    # `zenav up` is reached through its router, once, and the tool keeps going.
+    done = run(zenav(*TOOLS[tool](tmp_path), "--base-port", str(free_port_block(7)),
+                     "--duration", "4"), timeout=HANG)
+    assert done.returncode == 0, done.stderr
+    notes = [line for line in done.stderr.splitlines() if "nothing heard" in line]
+    assert notes == [f"zenav {tool}: nothing heard from robot0 in 3 s on the loopback mesh, "
+                     "where `zenav run` puts its services; a stack started with `zenav up` "
+                     "is reached through its router: --connect tcp/127.0.0.1:7447 (its "
+                     "default)"], done.stderr
+
+
 @pytest.mark.parametrize("tool", ["monitor", "record"])
 def test_a_duration_over_before_the_router_answers_says_so(tool: str, tmp_path: Path) -> None:
     done = run(zenav(*TOOLS[tool](tmp_path), "--connect", nobody(), "--connect-timeout", "30",

@@ -17,9 +17,12 @@ from zenav.services.writable import PathError, check_output_file
 from zenav.tooling import (
     CONNECT_TIMEOUT,
     ConnectError,
+    Heard,
     StampedSubscriber,
     add_connect_timeout,
+    note_if_quiet,
     open_bus,
+    quiet_note,
     signal_status,
     stop_on_signals,
     tool_setup,
@@ -62,19 +65,31 @@ async def record(transport: Any, robot_id: str, path: Path, *, duration: float |
     with stream:
         writer = BagWriter(stream, robot_id, exclude, foxglove=True)
         try:
-            subscriber = StampedSubscriber(bus, writer.keys.everything, writer.add)
+            heard = Heard()
+            own = writer.keys.alive("record")
+
+            def on_sample(key: str, payload: bytes, ns: int) -> None:
+                heard.mark()
+                writer.add(key, payload, ns)
+
+            subscriber = StampedSubscriber(bus, writer.keys.everything, on_sample)
 
             def on_liveliness(key: str, alive: bool) -> None:
                 nonlocal changes
                 changes += 1
+                if key != own:
+                    heard.mark()
                 writer.liveliness(key, alive, time.time_ns())
 
             bus.watch_liveliness(writer.keys.alive_any, on_liveliness)
             # Announced once subscribed: a simulator told to wait for `record` starts its
             # clock only when nothing can be missed.
-            token = bus.declare_token(writer.keys.alive("record"))
+            token = bus.declare_token(own)
             print(f"zenav record: recording {writer.keys.everything} to {path}", flush=True)
+            quiet = asyncio.create_task(
+                note_if_quiet(heard, stop, quiet_note("record", transport, robot_id)))
             await wait_for_event(stop, None)
+            quiet.cancel()
             token.undeclare()
             subscriber.close()
         finally:

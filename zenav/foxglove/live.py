@@ -23,9 +23,12 @@ from zenav.foxglove.scene import TOPICS
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
     CONNECT_TIMEOUT,
+    Heard,
     StampedSubscriber,
     add_connect_timeout,
+    note_if_quiet,
     open_bus,
+    quiet_note,
     run_tool,
     stop_on_signals,
     tool_setup,
@@ -65,12 +68,21 @@ async def serve(transport: Any, robot_id: str, host: str, port: int,
     if bus is None:  # stopped while connecting
         server.stop()
         return
-    subscriber = StampedSubscriber(bus, live.converter.keys.everything, live.add)
+    heard = Heard()
+
+    def on_sample(key: str, payload: bytes, ns: int) -> None:
+        heard.mark()
+        live.add(key, payload, ns)
+
+    subscriber = StampedSubscriber(bus, live.converter.keys.everything, on_sample)
     print(f"zenav foxglove: serving {live.converter.keys.everything} on "
           f"ws://{host}:{server.port}", flush=True)
+    quiet = asyncio.create_task(
+        note_if_quiet(heard, stop, quiet_note("foxglove", transport, robot_id)))
     try:
         await stop.wait()
     finally:
+        quiet.cancel()
         subscriber.close()
         bus.close()
         server.stop()

@@ -16,9 +16,12 @@ from zenav.monitor.screen import render
 from zenav.services.runner import add_transport_arguments
 from zenav.tooling import (
     CONNECT_TIMEOUT,
+    Heard,
     StampedSubscriber,
     add_connect_timeout,
+    note_if_quiet,
     open_bus,
+    quiet_note,
     run_tool,
     stop_on_signals,
     tool_setup,
@@ -43,11 +46,20 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
         print("zenav monitor: stopped before the session opened; nothing shown",
               file=sys.stderr)
         return
-    subscriber = StampedSubscriber(
-        bus, model.keys.everything,
-        lambda key, payload, ns: model.on_sample(key, payload, ns / 1e9))
-    bus.watch_liveliness(model.keys.alive_any,
-                         lambda key, alive: model.on_liveliness(key, alive, time.time()))
+    heard = Heard()
+
+    def on_sample(key: str, payload: bytes, ns: int) -> None:
+        heard.mark()
+        model.on_sample(key, payload, ns / 1e9)
+
+    def on_liveliness(key: str, alive: bool) -> None:
+        heard.mark()
+        model.on_liveliness(key, alive, time.time())
+
+    subscriber = StampedSubscriber(bus, model.keys.everything, on_sample)
+    bus.watch_liveliness(model.keys.alive_any, on_liveliness)
+    quiet = asyncio.create_task(
+        note_if_quiet(heard, stop, quiet_note("monitor", transport, robot_id)))
     try:
         if jsonl:
             while not stop.is_set():
@@ -70,6 +82,7 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
                     live.update(render(model, now, scale))
                     await wait_for_event(stop, period)
     finally:
+        quiet.cancel()
         subscriber.close()
         bus.close()
 
