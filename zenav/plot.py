@@ -355,7 +355,7 @@ def draw_animation(scenario: Scenario, record: dict[str, Any], path: Path,
     width, height = scenario.world.size
     with PLOT_LOCK:
         fig = Figure(figsize=(5, 5 * height / width))
-        canvas = FigureCanvasAgg(fig)
+        canvas: Any = FigureCanvasAgg(fig)  # (matplotlib leaves its methods untyped)
         ax = fig.subplots()
         _world(ax, scenario, None)
         ax.set_title("", fontsize=9)  # placed by the full draw, its text set per frame
