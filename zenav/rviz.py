@@ -31,8 +31,11 @@ from zenav.services.ros2.wire import MARKER_ARRAY, OCCUPANCY_GRID, PATH, WireErr
 from zenav.services.runner import add_transport_arguments
 from zenav.services.transport import Bus
 from zenav.tooling import (
+    Heard,
     add_connect_timeout,
+    note_if_quiet,
     open_bus,
+    quiet_note,
     run_tool,
     stop_on_signals,
     tool_setup,
@@ -62,16 +65,19 @@ class RvizView:
         self.states = bus.subscribe(self.keys.of(keys.PLANNER_STATE), depth=1)
         self.paths = bus.subscribe(self.keys.of(keys.PATH), depth=1)
         self.maps = bus.subscribe(self.keys.of(keys.MAP), depth=1)
+        self.heard = Heard()  # any message of the robot's, for the quiet note
         self.state: PlannerState | None = None
         self.sent = 0
         self.paths_sent = 0
         self.maps_sent = 0
 
     def on_state(self, payload: bytes) -> None:
+        self.heard.mark()
         with contextlib.suppress(DecodeError):
             self.state = decode(payload, PlannerState, self.keys.of(keys.PLANNER_STATE))
 
     def on_path(self, payload: bytes) -> None:
+        self.heard.mark()
         try:
             path = decode(payload, GlobalPath, self.keys.of(keys.PATH), keys.PATH.max_bytes)
         except DecodeError:
@@ -81,6 +87,7 @@ class RvizView:
         self.paths_sent += 1
 
     def on_map(self, payload: bytes) -> None:
+        self.heard.mark()
         try:
             occupancy = decode(payload, OccupancyMap, self.keys.of(keys.MAP), keys.MAP.max_bytes)
         except DecodeError:
@@ -89,6 +96,7 @@ class RvizView:
         self.maps_sent += 1
 
     def on_tracks(self, payload: bytes) -> None:
+        self.heard.mark()
         try:
             tracks = decode(payload, TrackList, self.keys.of(keys.TRACKS),
                             keys.TRACKS.max_bytes)
@@ -137,12 +145,15 @@ async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None
     view = RvizView(bus, robot_id, domain_id=args.domain_id, topic=args.topic, frame=args.frame,
                     path_topic=args.path_topic, map_topic=args.map_topic)
     task = asyncio.get_running_loop().create_task(view.run())
+    quiet = asyncio.get_running_loop().create_task(
+        note_if_quiet(view.heard, stop, quiet_note("rviz", transport, robot_id)))
     print(f"zenav rviz: robot {robot_id}'s tracks and planner state to {args.topic}, its path "
           f"to {args.path_topic} and its map to {args.map_topic} (ROS_DOMAIN_ID "
           f"{args.domain_id}, frame {args.frame}); Ctrl-C stops", flush=True)
     try:
         await stop.wait()
     finally:
+        quiet.cancel()
         task.cancel()
         with contextlib.suppress(asyncio.CancelledError):
             await task

@@ -38,11 +38,28 @@ async def test_tracks_become_markers_for_rviz():
         task.cancel()
         view.close()
     assert len(sent) == 1 and view.sent == 1
+    assert view.heard.anything  # no "nothing heard" note for this robot
     markers = wire.deserialize(sent[0], wire.MARKER_ARRAY).markers
     assert {m.ns for m in markers} == {"", "tracks", "velocity", "planner"}
     assert next(m for m in markers if m.ns == "planner").text.startswith("(c) slow")
     assert {(t.kind, t.topic) for t in tokens} == {("NN", None), ("MP", "/zenav/markers"),
                                                  ("MP", "/zenav/plan"), ("MP", "/zenav/map")}
+
+
+async def test_the_view_has_heard_nothing_until_a_message_comes():
+    bus = InMemoryBus()
+    view = RvizView(bus, "robot0", domain_id=3)
+    task = asyncio.create_task(view.run())
+    try:
+        bus.deliver(Keys("robot1").of(keys.TRACKS), encode(samples.tracks()))  # not ours
+        await asyncio.sleep(0.01)
+        before = view.heard.anything
+        bus.deliver(Keys("robot0").of(keys.PLANNER_STATE), encode(samples.state()))
+        await asyncio.sleep(0.01)
+    finally:
+        task.cancel()
+        view.close()
+    assert not before and view.heard.anything
 
 
 async def test_global_path_becomes_a_ros_path():
