@@ -20,7 +20,7 @@ import contextlib
 import sys
 from typing import Any
 
-from zenav.argtypes import count, nonempty
+from zenav.argtypes import count, nonempty, positive_float
 from zenav.schemas import keys
 from zenav.schemas.codec import DecodeError, decode
 from zenav.schemas.keys import Keys
@@ -139,6 +139,8 @@ class RvizView:
 async def serve(transport: Any, robot_id: str, args: argparse.Namespace) -> None:
     stop = asyncio.Event()
     stop_on_signals(stop)
+    if args.duration is not None:
+        asyncio.get_running_loop().call_later(args.duration, stop.set)
     bus = await open_bus(transport, stop, args.connect_timeout, "zenav rviz")
     if bus is None:  # stopped while connecting
         return
@@ -194,6 +196,7 @@ def add_command(sub: Any) -> None:
                       help="OccupancyGrid topic (default /zenav/map)")
     rviz.add_argument("--frame", type=nonempty, default="odom",
                       help="frame of zenav's poses (default odom)")
+    rviz.add_argument("--duration", type=positive_float, help="stop after this many s")
     add_transport_arguments(rviz)
     add_connect_timeout(rviz)
     rviz.set_defaults(func=main)

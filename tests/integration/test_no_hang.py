@@ -72,7 +72,7 @@ def test_a_tool_without_its_router_says_so_in_one_line(tool: str, tmp_path: Path
     assert "Traceback" not in done.stderr
 
 
-@pytest.mark.parametrize("tool", ["monitor", "record"])
+@pytest.mark.parametrize("tool", ["monitor", "record", "rviz"])
 def test_a_tool_with_a_dead_peer_honours_its_duration(tool: str, tmp_path: Path) -> None:
     started = time.monotonic()
     done = run(zenav(*TOOLS[tool](tmp_path), "--mode", "peer", "--connect", nobody(),
@@ -82,7 +82,7 @@ def test_a_tool_with_a_dead_peer_honours_its_duration(tool: str, tmp_path: Path)
     assert "Traceback" not in done.stderr
 
 
-@pytest.mark.parametrize("tool", ["monitor", "record", "foxglove"])
+@pytest.mark.parametrize("tool", ["monitor", "record", "foxglove", "rviz"])
 def test_a_tool_that_hears_nothing_says_where_to_look(tool: str, tmp_path: Path) -> None:
     # A loopback mesh no service is on: the note says that a stack started with
     # `zenav up` is reached through its router, once, and the tool keeps going.
