@@ -347,12 +347,16 @@ SampleCallback = Callable[[str, bytes, int], None]
 class StampedSubscriber:
     """Every sample of ``key_expr``, stamped with the wall clock in Zenoh's own callback
     (before any queueing), handed to ``callback`` on the asyncio loop. For tools that
-    measure time (monitor latency, recorder log times); services use ``Bus.subscribe``."""
+    measure time (monitor latency, recorder log times); services use ``Bus.subscribe``.
+    ``heard``, when given, is marked at every sample (for :func:`note_if_quiet`)."""
 
-    def __init__(self, bus: ZenohBus, key_expr: str, callback: SampleCallback) -> None:
+    def __init__(self, bus: ZenohBus, key_expr: str, callback: SampleCallback,
+                 heard: Heard | None = None) -> None:
         loop = asyncio.get_running_loop()
 
         def on_sample(sample: Any) -> None:
+            if heard is not None:
+                heard.mark()
             try:
                 now = time.time_ns()
                 loop.call_soon_threadsafe(callback, str(sample.key_expr),

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import GifImagePlugin, Image
 
 from zenav.plot import draw_animation
 from zenav.sim.scenario import parse_scenario
@@ -34,12 +34,12 @@ def test_each_frame_shows_the_run_at_its_second(tmp_path: Path) -> None:
     draw_animation(scenario, record, path, window_radius=2.0)
 
     gif = Image.open(path)
-    count = getattr(gif, "n_frames", 1)  # (a GIF's; PIL's stubs type the base class)
-    assert count == 5  # t = 0, 1, 2, 3, 4 s
+    assert isinstance(gif, GifImagePlugin.GifImageFile)
+    assert gif.n_frames == 5  # t = 0, 1, 2, 3, 4 s
     # 8 frames a second: 125 ms, which GIF keeps in hundredths of a second
     assert gif.info["duration"] == 120 and gif.info["loop"] == 0
     frames = []
-    for k in range(count):
+    for k in range(gif.n_frames):
         gif.seek(k)
         frames.append(np.asarray(gif.convert("RGB")))
     assert [len(mover_pixels(f)) > 0 for f in frames] == [False, False, True, True, True]

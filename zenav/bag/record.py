@@ -67,12 +67,7 @@ async def record(transport: Any, robot_id: str, path: Path, *, duration: float |
         try:
             heard = Heard()
             own = writer.keys.alive("record")
-
-            def on_sample(key: str, payload: bytes, ns: int) -> None:
-                heard.mark()
-                writer.add(key, payload, ns)
-
-            subscriber = StampedSubscriber(bus, writer.keys.everything, on_sample)
+            subscriber = StampedSubscriber(bus, writer.keys.everything, writer.add, heard)
 
             def on_liveliness(key: str, alive: bool) -> None:
                 nonlocal changes

@@ -69,12 +69,7 @@ async def serve(transport: Any, robot_id: str, host: str, port: int,
         server.stop()
         return
     heard = Heard()
-
-    def on_sample(key: str, payload: bytes, ns: int) -> None:
-        heard.mark()
-        live.add(key, payload, ns)
-
-    subscriber = StampedSubscriber(bus, live.converter.keys.everything, on_sample)
+    subscriber = StampedSubscriber(bus, live.converter.keys.everything, live.add, heard)
     print(f"zenav foxglove: serving {live.converter.keys.everything} on "
           f"ws://{host}:{server.port}", flush=True)
     quiet = asyncio.create_task(

@@ -48,15 +48,13 @@ async def monitor(transport: Any, robot_id: str, *, jsonl: bool, period: float,
         return
     heard = Heard()
 
-    def on_sample(key: str, payload: bytes, ns: int) -> None:
-        heard.mark()
-        model.on_sample(key, payload, ns / 1e9)
-
     def on_liveliness(key: str, alive: bool) -> None:
         heard.mark()
         model.on_liveliness(key, alive, time.time())
 
-    subscriber = StampedSubscriber(bus, model.keys.everything, on_sample)
+    subscriber = StampedSubscriber(
+        bus, model.keys.everything,
+        lambda key, payload, ns: model.on_sample(key, payload, ns / 1e9), heard)
     bus.watch_liveliness(model.keys.alive_any, on_liveliness)
     quiet = asyncio.create_task(
         note_if_quiet(heard, stop, quiet_note("monitor", transport, robot_id)))
