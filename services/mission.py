@@ -38,11 +38,15 @@ RANGE_MAX = 8.0
 """The laser's longest range, m (the paper's SICK scanner)."""
 WINDOW_CELLS = 8
 """The sliding window reaches this many cells round the robot (paper: 8 x 0.5 m)."""
+WINDOW_FLOOR = 4.0
+"""The least window, m: the paper's 8 cells of 0.5 m. With a finer grid, 8 cells alone
+leave a robot nearly blind to movers (0.8 m at 0.1 m cells: README, "Departures")."""
 
 
 def window_radius(cell: float, range_max: float) -> float:
-    """r_w, m: ``WINDOW_CELLS`` cells, but no farther than the laser sees."""
-    return min(WINDOW_CELLS * cell, range_max)
+    """r_w, m: ``WINDOW_CELLS`` cells, never less than ``WINDOW_FLOOR``, and no farther
+    than the laser sees."""
+    return min(max(WINDOW_CELLS * cell, WINDOW_FLOOR), range_max)
 
 
 WINDOW_RADIUS = window_radius(CELL, RANGE_MAX)

@@ -28,7 +28,7 @@ from pydantic import (
 )
 
 from zenav.services.inputs import AliasError, BoundedLoader, not_valid_yaml, safe_load, shown
-from zenav.services.mission import WINDOW_CELLS, window_radius
+from zenav.services.mission import WINDOW_CELLS, WINDOW_FLOOR, window_radius
 
 __all__ = [
     "LaserSpec",
@@ -367,8 +367,9 @@ def limit_problems(scenario: Scenario) -> list[tuple[Loc, str]]:
     if window_radius(scenario.world.cell, scenario.laser.max_range) < scenario.world.cell:
         problems.append((("laser", "max_range"), f"must be at least world.cell "
                          f"({scenario.world.cell:g} m): the perception window reaches "
-                         f"{WINDOW_CELLS} cells but no farther than the laser, and must hold "
-                         f"a cell (got {scenario.laser.max_range:g} m)"))
+                         f"{WINDOW_CELLS} cells (at least {WINDOW_FLOOR:g} m) but no farther "
+                         f"than the laser, and must hold a cell "
+                         f"(got {scenario.laser.max_range:g} m)"))
     robot = scenario.robot
     if robot.effective_max_speed < robot.speed:
         problems.append((("robot", "max_speed"), f"must be at least robot.speed "

@@ -169,8 +169,8 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("run a grid cell larger than the laser reaches",
      lambda t: ["run", str(scenario_with(t, "big", world__cell=10.0)), "--out", str(t / "o")],
      2, "zenav run: {t}/big.yaml: laser.max_range: must be at least world.cell (10 m): the "
-     "perception window reaches 8 cells but no farther than the laser, and must hold a cell "
-     "(got 8 m)"),
+     "perception window reaches 8 cells (at least 4 m) but no farther than the laser, and "
+     "must hold a cell (got 8 m)"),
     ("run a top speed below the cruise speed",
      lambda t: ["run", str(scenario_with(t, "slow", robot__max_speed=0.05)),
                 "--out", str(t / "o")], 2,

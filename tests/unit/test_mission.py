@@ -35,7 +35,7 @@ def models() -> dict[str, type[BaseModel]]:
 def test_stack_params_derive_the_robot_laser_and_window_from_the_scenario() -> None:
     scenario = load_scenario(SCENARIO)
     params = stack_params(scenario, SCENARIO)
-    window = min(8 * scenario.world.cell, scenario.laser.max_range)
+    window = min(max(8 * scenario.world.cell, 4.0), scenario.laser.max_range)
     assert window_radius(scenario.world.cell, scenario.laser.max_range) == window
     for service in ("perception", "tracking", "planner"):
         assert params[service]["window_radius"] == window
@@ -44,6 +44,19 @@ def test_stack_params_derive_the_robot_laser_and_window_from_the_scenario() -> N
     assert params["laser_driver"]["range_max"] == scenario.laser.max_range
     assert params["simulator"]["scenario"] == str(SCENARIO.resolve())
     assert params["simulator"]["wait_for"][-1] == "run"
+
+
+@pytest.mark.parametrize(("cell", "range_max", "window"), [
+    (0.5, 8.0, 4.0),    # the paper's: 8 cells of 0.5 m
+    (1.0, 8.0, 8.0),    # a coarser grid: still 8 cells
+    (0.25, 8.0, 4.0),   # a finer one: never below the paper's 4 m
+    (0.1, 8.0, 4.0),
+    (0.1, 3.0, 3.0),    # and never beyond the laser
+    (1.0, 6.0, 6.0),
+])
+def test_the_window_is_eight_cells_but_never_less_than_four_metres(
+        cell: float, range_max: float, window: float) -> None:
+    assert window_radius(cell, range_max) == window
 
 
 @pytest.mark.parametrize("model", sorted(models()))
