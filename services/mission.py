@@ -30,6 +30,9 @@ ACCEL = 0.5
 """Forward acceleration limit of the commands, m/s^2 (the motor bridge's; DWA plans with it)."""
 DECEL = 1.0
 """Forward deceleration limit of the commands, m/s^2 (the motor bridge's; DWA plans with it)."""
+MAX_REVERSE_SPEED = 0.1
+"""Reverse speed limit, m/s: the motor bridge passes no faster reverse (the laser does not
+see behind), and the paper planner times a spot aside it backs to with it."""
 
 # --- the world window ------------------------------------------------------------------
 CELL = 0.5

@@ -7,7 +7,14 @@ from typing import Literal
 
 from pydantic import ConfigDict, Field
 
-from zenav.services.mission import ACCEL, MAX_OMEGA, MAX_SPEED, ROBOT_RADIUS, SCAN_WAIT
+from zenav.services.mission import (
+    ACCEL,
+    MAX_OMEGA,
+    MAX_REVERSE_SPEED,
+    MAX_SPEED,
+    ROBOT_RADIUS,
+    SCAN_WAIT,
+)
 from zenav.services.motor_bridge.stop_zone import StopZoneParams
 from zenav.services.ros2.params import Ros2Params
 
@@ -21,8 +28,9 @@ class Params(StopZoneParams):
     max_speed: float = Field(MAX_SPEED, gt=0, description="forward speed limit, m/s")
     allow_reverse: bool = Field(False, description="whether negative speeds pass")
     max_reverse_speed: float = Field(
-        0.1, gt=0, description="reverse speed limit when allow_reverse, m/s (the paper "
-        "planner backs up only in recovery, slowly: the laser does not see behind)")
+        MAX_REVERSE_SPEED, gt=0, description="reverse speed limit when allow_reverse, m/s "
+        "(the paper planner backs slowly, in recovery and to a spot aside: the laser does "
+        "not see behind)")
     max_omega: float = Field(MAX_OMEGA, gt=0, description="turn rate limit, rad/s")
     accel: float = Field(ACCEL, gt=0, description="forward acceleration limit, m/s^2")
     angular_accel: float = Field(4.0, gt=0, description="turn rate change limit, rad/s^2")

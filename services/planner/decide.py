@@ -829,7 +829,8 @@ class Planner:
             threats.append(dataclasses.replace(base, letter="e", threat=True))
         if p.threats_per_cycle == "one" and threats:  # Algorithm 1: first in O_chain, break
             threats = [first_in_scan_order(threats, robot, pose[2])]
-        if self.hold is None and self._start_hold(robot, target, threats, in_window, stamp):
+        if self.hold is None and self._start_hold(robot, pose[2], target, threats, in_window,
+                                                  stamp):
             aside = self.hold_aside(pose, obstacles, stamp)
             if aside is not None:
                 self.detour = None
@@ -1132,7 +1133,7 @@ class Planner:
 
     # -- stage: giving way in a corridor -----------------------------------------------
 
-    def _start_hold(self, robot: Vec, target: Vec, threats: list[Assessment],
+    def _start_hold(self, robot: Vec, heading: float, target: Vec, threats: list[Assessment],
                     in_window: list[Obstacle], stamp: float) -> bool:
         """Beyond the paper: when the one mover in the window comes head-on and threatens,
         or comes up from behind on the robot's line faster than the robot can go
@@ -1168,7 +1169,8 @@ class Planner:
         position = np.asarray(mover.position, dtype=np.float64)
         near = 1 if offsets(robot[None, :], position, way)[0] >= 0.0 else -1
         for side in (near, -near):
-            spot = self._spot_aside(robot, position, way, speed, radius, side, overtaking)
+            spot = self._spot_aside(robot, heading, position, way, speed, radius, side,
+                                    overtaking)
             if spot is not None:
                 self.hold = Hold(
                     spot=(float(spot[0]), float(spot[1])), side=side, radius=radius,
@@ -1202,11 +1204,13 @@ class Planner:
             return False  # beside or ahead of the robot already, or passing it clear
         return (behind - clearance) / (speed - p.max_speed) <= p.horizon
 
-    def _spot_aside(self, robot: Vec, position: Vec, way: Vec, speed: float, radius: float,
-                    side: int, overtaking: bool = False) -> Vec | None:
+    def _spot_aside(self, robot: Vec, heading: float, position: Vec, way: Vec, speed: float,
+                    radius: float, side: int, overtaking: bool = False) -> Vec | None:
         """``give_way.spot_aside`` with the planner's map and parameters: a spot the mover
         passes with the whole safety margin to spare where there is one, else half,
-        reached at ``cruise_speed`` after a square turn; from a mover ``overtaking``,
+        reached at ``cruise_speed`` after a square turn (across the mover's line and
+        behind the robot, at ``max_reverse_speed``: it backs there); from a mover
+        ``overtaking``,
         which comes faster than the robot can go, a spot ahead within 45 degrees, reached
         at ``max_speed`` after that turn."""
         assert self.costmap is not None
@@ -1218,7 +1222,7 @@ class Planner:
                 self.costmap.blocked_at, lambda a, b: self._disc_clear(self._leg(a, b)),
                 p.give_way_reach, p.map_resolution / 2,
                 p.max_speed if overtaking else p.cruise_speed, lead=turn / p.max_omega,
-                ahead=overtaking)
+                ahead=overtaking, backing=(heading, p.max_reverse_speed))
             if spot is not None:
                 return spot
         return None
@@ -1274,8 +1278,9 @@ class Planner:
         way = np.asarray(hold.way, dtype=np.float64)
         held = np.asarray(hold.spot, dtype=np.float64)[None, :]
         if offsets(held, position, way)[0] * hold.side < p.robot_radius + hold.radius:
-            better = self._spot_aside(robot, position, way, math.hypot(*hold.velocity),
-                                      hold.radius, hold.side, hold.overtaking)
+            better = self._spot_aside(robot, pose[2], position, way,
+                                      math.hypot(*hold.velocity), hold.radius, hold.side,
+                                      hold.overtaking)
             if better is not None:
                 hold.spot = (float(better[0]), float(better[1]))
         spot = np.asarray(hold.spot, dtype=np.float64)

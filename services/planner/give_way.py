@@ -121,7 +121,8 @@ def offsets(points: Vec, mover: Vec, way: Vec) -> Vec:
 def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
                side: int, blocked_at: BlockedAt, leg_clear: Callable[[Vec, Vec], bool],
                reach: float, step: float, robot_speed: float, lead: float,
-               ahead: bool = False) -> Vec | None:
+               ahead: bool = False,
+               backing: tuple[float, float] | None = None) -> Vec | None:
     """The nearest point within ``reach`` m of ``robot`` (on a ``step`` m grid) that is
     free on the map, at least ``clearance`` m to ``side`` (+1 left, -1 right) of the
     line the mover walks (through ``mover`` along ``way``, unit, at ``speed``), and
@@ -129,7 +130,10 @@ def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
     turn) before the mover comes within the clearance of being abreast of it; None if
     none is, or if the mover does not come toward the robot. ``ahead``: only points at
     most 45 degrees off ``way`` from the robot (a mover overtaking it: the robot swerves
-    on along its way, with no time for a square turn)."""
+    on along its way, with no time for a square turn). ``backing``: the robot's heading
+    (rad) and its reverse speed limit (m/s). A robot on the other side of the mover's
+    line crosses in front of the mover to a spot on this side, and it backs to a spot
+    behind it: such a spot is timed at no more than the reverse limit."""
     if speed < 1e-9 or robot_speed <= 0.0:
         return None
     if float((robot - mover) @ way) <= clearance:
@@ -142,7 +146,12 @@ def spot_aside(robot: Vec, mover: Vec, way: Vec, speed: float, clearance: float,
     points, distance = robot[None, :] + grid[keep], distance[keep]
     aside = offsets(points, mover, way) * side >= clearance
     along = (points - mover[None, :]) @ way
-    ok = aside & ((along - clearance) / speed >= distance / robot_speed + lead)
+    speeds = np.full(len(points), robot_speed)
+    if backing is not None and float(offsets(robot[None, :], mover, way)[0]) * side < 0.0:
+        heading, reverse = backing
+        behind = (points - robot[None, :]) @ np.array([math.cos(heading), math.sin(heading)]) < 0
+        speeds[behind] = min(robot_speed, reverse)
+    ok = aside & ((along - clearance) / speed >= distance / speeds + lead)
     if ahead:
         forward = (points - robot[None, :]) @ way
         ok &= forward >= np.abs(offsets(points, robot, way)) - 1e-9

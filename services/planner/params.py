@@ -11,6 +11,7 @@ from zenav.services.mission import (
     ACCEL,
     CELL,
     MAX_OMEGA,
+    MAX_REVERSE_SPEED,
     MAX_SPEED,
     ROBOT_RADIUS,
     SCAN_WAIT,
@@ -325,6 +326,10 @@ class Params(MissionParams, StopZoneParams):
     give_way_patience: float = Field(
         3.0, gt=0, description="a spot aside is given up when the mover has not been seen, "
         "or not seen moving, for this long, s"
+    )
+    max_reverse_speed: float = Field(
+        MAX_REVERSE_SPEED, gt=0, description="the motor bridge's reverse speed limit, m/s: "
+        "a spot aside across the mover's line and behind the robot is timed at it"
     )
 
     def arrival_distance(self) -> float:

@@ -303,3 +303,28 @@ def test_no_hold_for_a_walker_that_is_not_overtaking_in_a_corridor(
     d = p.step(pose, [overtaker(x, y, speed)], t,
                scan_of(pose, boxes=boxes, discs=[(x, y, 0.2)], fov_deg=360.0))
     assert p.hold is None and d.action != "give_way"
+
+
+def test_spot_aside_across_the_line_and_behind_is_timed_at_the_reverse_limit() -> None:
+    # The robot at (0, 0.3), on the far side of the line of a mover at (2, 0) walking -x
+    # at 0.2 m/s; clearance 0.45: a spot for side +1 has y <= -0.45, across the line.
+    # Nearest on the 0.05 m grid, (0, -0.5) (the point at -0.45 falls short of the
+    # clearance by a rounding), 0.8 m away: at 0.2 m/s, 0.8 / 0.2 + 1.5 = 5.5 s against
+    # (2 - 0.45) / 0.2 = 7.75 s for the mover: in time. Facing away from the line
+    # (heading +90 degrees) it lies behind, and the robot backs there at 0.1 m/s:
+    # 0.8 / 0.1 + 1.5 = 9.5 s, too late, and every spot farther back is later still.
+    robot, mover, way = np.array([0.0, 0.3]), np.array([2.0, 0.0]), np.array([-1.0, 0.0])
+
+    def spot(backing: tuple[float, float] | None) -> Vec | None:
+        return give_way.spot_aside(robot, mover, way, 0.2, 0.45, 1, corridor(0.6), always,
+                                   1.0, 0.05, 0.2, 1.5, backing=backing)
+
+    assert spot(None) == pytest.approx([0.0, -0.5])
+    assert spot((math.pi / 2, 0.1)) is None
+    # Facing the line, the robot drives there forward: the same spot.
+    assert spot((-math.pi / 2, 0.1)) == pytest.approx([0.0, -0.5])
+    # On its own side (side -1: y >= 0.45) it needs no crossing: timed as before even
+    # where it backs, as the hold then also drives it.
+    own = give_way.spot_aside(robot, mover, way, 0.2, 0.45, -1, corridor(0.6), always,
+                              1.0, 0.05, 0.2, 1.5, backing=(-math.pi / 2, 0.1))
+    assert own == pytest.approx([0.0, 0.45], abs=1e-9)
