@@ -41,8 +41,8 @@ RANGE_MAX = 8.0
 """The laser's longest range, m (the paper's SICK scanner)."""
 WINDOW_CELLS = 8
 """The sliding window reaches this many cells round the robot (paper: 8 x 0.5 m)."""
-WINDOW_FLOOR = 4.0
-"""The least window, m: the paper's 8 cells of 0.5 m. With a finer grid, 8 cells alone
+WINDOW_FLOOR = WINDOW_CELLS * CELL
+"""The least window, m: the paper's 8 cells of 0.5 m (4 m). With a finer grid, 8 cells alone
 leave a robot nearly blind to movers (0.8 m at 0.1 m cells: README, "Departures")."""
 
 
