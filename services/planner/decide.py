@@ -1017,7 +1017,8 @@ class Planner:
             decision = decision or self.local_layer(pose, obstacles, stamp)
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
-            decision = self.guard_stop_zone(decision, pose, scan)
+            decision = self.guard_stop_zone(self.brake_for_goal(decision, pose, scan),
+                                            pose, scan)
             if decision.refused and self._blocked_within_window(robot, stamp):
                 # The stop zone refuses the way along a path that runs into what the map
                 # has come to hold since it was planned (a wall's end seen late): the
@@ -1623,6 +1624,31 @@ class Planner:
         return Decision(0.0, 0.0, goal_xy, "a", "wait", None, None, 0.0)
 
     # -- stage: the stop zone ----------------------------------------------------------
+
+    def brake_for_goal(self, d: Decision, pose: tuple[float, float, float],
+                       scan: ScanData | None) -> Decision:
+        """``goal_braking``: on a free run at the goal itself (``keep``), the speed from
+        which braking at the bridge's ``decel`` stops the robot on the goal, sqrt(2 decel
+        d), where the local layer slowed to the distance d (one second of travel): a fast
+        robot does not spend its last metre slowing down. Only where the stop zone at that
+        speed holds no return even after ``zone_reaction`` s more at it, so what stands
+        beyond the goal never makes the zone refuse an approach the slower one made; and
+        not toward a goal settled off what the map holds there (``settle_goal``)."""
+        p = self.p
+        if (not p.goal_braking or d.action != "keep" or d.v <= 0.0 or scan is None
+                or not p.stop_zone
+                or math.dist(d.target, (float(self.goal[0]), float(self.goal[1]))) > 1e-9
+                or not np.array_equal(self.goal, self.mission_goal)):
+            return d
+        v, omega = command_toward(pose[0], pose[1], pose[2], d.target, d.speed,
+                                  p.heading_gain, p.max_omega, brake=p.decel)
+        if v <= d.v:
+            return d
+        nearer = scan.ranges.astype(np.float32) - np.float32(v * p.zone_reaction)
+        if p.blocks(nearer, scan.angle_min, scan.angle_increment, scan.range_max, v,
+                    p.robot_radius):
+            return d
+        return dataclasses.replace(d, v=v, omega=omega)
 
     def guard_stop_zone(self, d: Decision, pose: tuple[float, float, float],
                         scan: ScanData | None) -> Decision:

@@ -309,6 +309,13 @@ class Params(MissionParams, StopZoneParams):
         "run back to back), before the goal is declared unreachable"
     )
 
+    goal_braking: bool = Field(
+        True, description="beyond the paper: on a free run at the goal, ask for the speed "
+        "from which braking at decel stops the robot on it, sqrt(2 decel d), where the stop "
+        "zone at that speed stays clear for zone_reaction s more, instead of slowing to the "
+        "distance d (one second of travel); not toward a goal settled off the map's cells"
+    )
+
     # --- giving way (give_way.py) -----------------------------------------------------
     give_way: bool = Field(
         True, description="beyond the paper: between walls (the map holds something within "

@@ -574,3 +574,57 @@ def test_a_path_the_stop_zone_refuses_where_the_map_blocks_it_is_planned_again()
     assert p.plan is not None and p.plan.found and p.plan.reason == "blocked within the window"
     assert p.costmap is not None and p.path is not None
     assert not p.costmap.blocked_at(p.path[1:], outside=True).any()
+
+
+# -- braking for the goal -----------------------------------------------------------------
+
+
+def fast(**changes: object) -> Planner:
+    return planner(cruise_speed=1.0, max_speed=1.0, goal_tolerance=0.3, **changes)
+
+
+@pytest.mark.parametrize("to_go", [0.3, 0.6, 0.9])
+def test_toward_the_goal_a_fast_robot_brakes_at_the_bridge_s_rate_to_stop_on_it(
+        to_go: float) -> None:
+    """Near its goal the robot asks for the speed from which the motor bridge's braking
+    stops it on the goal, sqrt(2 decel d), not the distance itself: a 1 m/s robot does
+    not spend its last metre slowing down."""
+    p = fast()
+    pose = (8.0 - to_go, 3.0, 0.0)
+    d = p.step(pose, [], 0.0, scan_of(pose))
+    assert (d.scenario, d.action) == ("a", "keep")
+    assert d.target == pytest.approx((8.0, 3.0))  # within the look-ahead: the goal
+    assert d.v == pytest.approx(min(1.0, math.sqrt(2.0 * p.p.decel * to_go)))
+    assert d.v > to_go  # one second of travel would ask for the distance
+
+
+def test_braking_for_the_goal_off_the_robot_slows_to_the_distance() -> None:
+    p = fast(goal_braking=False)
+    pose = (7.4, 3.0, 0.0)
+    assert p.step(pose, [], 0.0, scan_of(pose)).v == pytest.approx(0.6)
+
+
+def test_a_wall_beyond_the_goal_that_the_faster_stop_zone_would_reach_keeps_the_slow_law(
+        ) -> None:
+    """The zone at sqrt(2 decel d) reaches farther than the zone at d: where it (after
+    ``zone_reaction`` s more at that speed) would hold the wall beyond the goal, the
+    robot slows to the distance as before, which the zone lets through."""
+    pose = (7.4, 3.0, 0.0)
+    wall = [(8.55, 1.0, 9.0, 5.0)]  # 0.35 m beyond the goal: not near enough to move it
+    p = fast()
+    d = p.step(pose, [], 0.0, scan_of(pose, boxes=wall))
+    assert not d.refused and d.v == pytest.approx(0.6)
+    far = [(9.5, 1.0, 10.0, 5.0)]
+    p = fast()
+    assert p.step(pose, [], 0.0, scan_of(pose, boxes=far)).v > 0.6
+
+
+def test_toward_a_point_short_of_the_goal_the_speed_still_falls_to_the_distance() -> None:
+    """Only the goal itself is braked for: the look-ahead point on the path short of it
+    is no place to stop, and the speed toward it stays capped at its distance."""
+    p = planner(cruise_speed=1.5, max_speed=1.5)
+    ahead = p.p.lookahead
+    pose = (8.0 - ahead - 0.3, 3.0, 0.0)
+    d = p.step(pose, [], 0.0, scan_of(pose))
+    assert d.target == pytest.approx((8.0 - 0.3, 3.0))
+    assert d.v == pytest.approx(ahead) and d.v < math.sqrt(2.0 * p.p.decel * ahead)
