@@ -942,8 +942,17 @@ class Planner:
 
         self.asked = speed
         tx, ty = float(target[0]), float(target[1])
+        # The speed falls to the target's distance in a second of travel; toward the
+        # look-ahead point on the path (short of the goal), in the time the speed asked
+        # takes to cover the look-ahead, when that is shorter: else no robot could go
+        # faster than the look-ahead per second (1 m/s) on a straight path. Below that
+        # speed nothing changes; in a bend the point comes closer and slows the robot.
+        within = 1.0
+        if (self.detour is None and target is path_target and speed > p.lookahead
+                and float(np.hypot(*(target - self.goal))) > 1e-9):
+            within = p.lookahead / speed
         v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,
-                                  p.heading_gain, p.max_omega)
+                                  p.heading_gain, p.max_omega, within=within)
         obstacle = lead.obstacle.id if lead is not None else (
             self.detour.obstacle if self.detour is not None else None)
         # An event names the obstacle's type whenever it names an obstacle: on a detour,

@@ -16,14 +16,16 @@ def command_toward(
     heading_gain: float,
     max_omega: float,
     brake: float | None = None,
+    within: float = 1.0,
 ) -> tuple[float, float]:
     """(v, omega) that heads for ``target`` at up to ``speed`` m/s.
 
     The turn rate is proportional to the heading error; the forward speed falls with
     the cosine of the error, so the robot turns on the spot when the target is behind it.
-    Near the target the speed falls so as not to overshoot it: to the distance in m
-    (one second of travel), or, with ``brake`` (m/s^2), to the speed from which braking
-    at that rate stops the robot on the target, sqrt(2 brake distance).
+    Near the target the speed falls so as not to overshoot it: to the speed that covers
+    the distance in ``within`` s (one second of travel by default), or, with ``brake``
+    (m/s^2), to the speed from which braking at that rate stops the robot on the target,
+    sqrt(2 brake distance).
     """
     dx, dy = target[0] - x, target[1] - y
     distance = math.hypot(dx, dy)
@@ -31,7 +33,7 @@ def command_toward(
         return 0.0, 0.0
     error = wrap_angle(math.atan2(dy, dx) - heading)
     omega = max(-max_omega, min(max_omega, heading_gain * error))
-    near = distance if brake is None else math.sqrt(2.0 * brake * distance)
+    near = distance / within if brake is None else math.sqrt(2.0 * brake * distance)
     v = min(speed, near) * max(0.0, math.cos(error))
     return v, omega
 
@@ -45,9 +47,10 @@ def backing_toward(
     heading_gain: float,
     max_omega: float,
     brake: float | None = None,
+    within: float = 1.0,
 ) -> tuple[float, float]:
     """(v, omega) that backs toward ``target`` at up to ``speed`` m/s: the rear turned
     toward it as ``command_toward`` turns the front, v negative."""
     v, omega = command_toward(x, y, heading + math.pi, target, speed, heading_gain, max_omega,
-                              brake)
+                              brake, within)
     return -v, omega

@@ -48,3 +48,10 @@ def test_on_the_target_there_is_nothing_to_do() -> None:
 def test_backing_turns_the_rear_toward_the_target_and_drives_it_backwards() -> None:
     v, omega = backing_toward(0.0, 0.0, 0.0, (-2.0, 0.0), 0.1, 2.0, 1.0)
     assert (v, omega) == (-0.1, 0.0)
+
+
+def test_the_speed_falls_to_the_distance_covered_in_the_time_given() -> None:
+    v, _ = command_toward(0.0, 0.0, 0.0, (0.3, 0.0), 2.0, 2.0, 1.0, within=0.5)
+    assert v == pytest.approx(0.6)
+    v, _ = command_toward(0.0, 0.0, 0.0, (1.0, 0.0), 1.5, 2.0, 1.0, within=1.0 / 1.5)
+    assert v == pytest.approx(1.5)

@@ -619,12 +619,27 @@ def test_a_wall_beyond_the_goal_that_the_faster_stop_zone_would_reach_keeps_the_
     assert p.step(pose, [], 0.0, scan_of(pose, boxes=far)).v > 0.6
 
 
-def test_toward_a_point_short_of_the_goal_the_speed_still_falls_to_the_distance() -> None:
-    """Only the goal itself is braked for: the look-ahead point on the path short of it
-    is no place to stop, and the speed toward it stays capped at its distance."""
+def test_a_robot_faster_than_the_look_ahead_per_second_drives_at_its_cruise_speed() -> None:
+    """Toward the look-ahead point on the path (1 m on) the speed falls to its distance
+    in the time the speed asked takes to cover the look-ahead: on a straight path that
+    is the speed asked. In a second of travel, as toward other targets, no robot could
+    go faster than 1 m/s."""
     p = planner(cruise_speed=1.5, max_speed=1.5)
     ahead = p.p.lookahead
     pose = (8.0 - ahead - 0.3, 3.0, 0.0)
     d = p.step(pose, [], 0.0, scan_of(pose))
-    assert d.target == pytest.approx((8.0 - 0.3, 3.0))
-    assert d.v == pytest.approx(ahead) and d.v < math.sqrt(2.0 * p.p.decel * ahead)
+    assert d.target == pytest.approx((8.0 - 0.3, 3.0))  # the look-ahead point
+    assert d.action == "keep" and d.v == pytest.approx(1.5) and ahead < 1.5
+
+
+def test_a_robot_at_most_the_look_ahead_per_second_slows_as_before_in_a_bend() -> None:
+    """A look-ahead point brought nearer by a bend in the path still slows the robot to
+    its distance in a second when the speed asked is at most 1 m/s."""
+    p = planner(cruise_speed=1.0, max_speed=1.0)
+    pose = (5.0, 3.0, 0.0)
+    p.step(pose, [], 0.0, scan_of(pose))
+    p._set_path(np.array([[2.0, 3.0], [5.2, 3.0], [5.2, 9.0]]), "a bend 0.2 m on")
+    d = p.local_layer(pose, [], 0.1)
+    near = math.dist(d.target, pose[:2])
+    assert near < 0.9 and d.v == pytest.approx(near * math.cos(
+        math.atan2(d.target[1] - 3.0, d.target[0] - 5.0)))
