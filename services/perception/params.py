@@ -69,12 +69,11 @@ class PerceptionParams(BaseModel):
         "3 standard deviations of 0.03 m range noise.",
     )
     motion_baselines: tuple[float, ...] = Field(
-        (0.2, 0.5, 1.0, 2.0, 4.0),
+        (0.2, 0.5, 1.0, 2.0),
         description="seconds: earlier scans the motion test compares with. A mover is seen "
         "once it has moved motion_margin in one of them: 0.5 m/s after 0.2 s (a walker "
         "coming out from behind another is typed moving by its third scan), 0.2 m/s after "
-        "0.5 s, 0.05 m/s after 2 s, 0.025 m/s after 4 s (a walker as slow as the planner's "
-        "moving_speed, 0.03 m/s).",
+        "0.5 s, 0.05 m/s after 2 s.",
     )
     motion_reach: float = Field(
         0.3,
