@@ -949,7 +949,7 @@ class Planner:
         # speed nothing changes; in a bend the point comes closer and slows the robot.
         within = 1.0
         if (self.detour is None and target is path_target and speed > p.lookahead
-                and float(np.hypot(*(target - self.goal))) > 1e-9):
+                and not self._is_goal(target)):
             within = p.lookahead / speed
         v, omega = command_toward(robot[0], robot[1], pose[2], (tx, ty), speed,
                                   p.heading_gain, p.max_omega, within=within)
@@ -1302,6 +1302,8 @@ class Planner:
         assert self.costmap is not None  # a hold starts only on a map
         lane_free = not self.costmap.blocked_at(
             path_points(on_lane, go, p.lookahead, p.map_resolution / 2)).any()
+        drive: Callable[[float, float, float, tuple[float, float], float, float, float],
+                        tuple[float, float]]
         if hold.overtaking:
             # The spot lies ahead: swerve into its lane and go on along it, at top speed
             # until in the lane (to half a map cell), then at cruise speed. Where the map
@@ -1645,8 +1647,7 @@ class Planner:
         not toward a goal settled off what the map holds there (``settle_goal``)."""
         p = self.p
         if (not p.goal_braking or d.action != "keep" or d.v <= 0.0 or scan is None
-                or not p.stop_zone
-                or math.dist(d.target, (float(self.goal[0]), float(self.goal[1]))) > 1e-9
+                or not p.stop_zone or not self._is_goal(d.target)
                 or not np.array_equal(self.goal, self.mission_goal)):
             return d
         v, omega = command_toward(pose[0], pose[1], pose[2], d.target, d.speed,
@@ -1658,6 +1659,11 @@ class Planner:
                     p.robot_radius):
             return d
         return dataclasses.replace(d, v=v, omega=omega)
+
+    def _is_goal(self, point: Vec | tuple[float, float]) -> bool:
+        """Whether ``point`` is the goal the robot stops at (the settled one)."""
+        return math.dist((float(point[0]), float(point[1])),
+                         (float(self.goal[0]), float(self.goal[1]))) <= 1e-9
 
     def guard_stop_zone(self, d: Decision, pose: tuple[float, float, float],
                         scan: ScanData | None) -> Decision:

@@ -46,11 +46,8 @@ def backing_toward(
     speed: float,
     heading_gain: float,
     max_omega: float,
-    brake: float | None = None,
-    within: float = 1.0,
 ) -> tuple[float, float]:
     """(v, omega) that backs toward ``target`` at up to ``speed`` m/s: the rear turned
     toward it as ``command_toward`` turns the front, v negative."""
-    v, omega = command_toward(x, y, heading + math.pi, target, speed, heading_gain, max_omega,
-                              brake, within)
+    v, omega = command_toward(x, y, heading + math.pi, target, speed, heading_gain, max_omega)
     return -v, omega
