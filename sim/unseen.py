@@ -14,6 +14,17 @@ looked at first:
 - ``mover-stops``: a mover that comes across (or toward the robot) and stops on the way;
 - ``facing-away``: the robot starts facing away from its goal, a box on the line.
 
+Beyond those classes, three with walkers that react (ORCA agents, ``behavior: orca``,
+each seeing the robot or not at even odds, at 0.2–0.6 m/s): the issue names its crowds
+only in CrowdNav's open square, and these put them where walls leave little room:
+
+- ``walkers-corridor``: a walled corridor on the line, 1.6–2.6 m wide inside, with one
+  to three walkers going along it, each the robot's way or toward it;
+- ``walkers-doorway``: a wall across the world with one door, off the straight line or on
+  it, and a walker coming through it from the goal's side to the robot's;
+- ``walkers-across``: two to four walkers pacing to and fro across the robot's way
+  between two points either side of the line.
+
 Each scene is drawn in a frame where the robot drives toward +x, then turned by a
 multiple of 90 degrees (so boxes stay axis-aligned) and maybe mirrored, so goals lie in
 every direction. A draw is kept only when :func:`solvable` finds a way for the robot
@@ -34,6 +45,10 @@ from scipy import ndimage
 from zenav.sim.scenario import Scenario, parse_scenario
 
 CLASSES = ("appear", "wall-gap", "cup", "corridor", "posts", "mover-stops", "facing-away")
+"""The navigation classes issue 12 names (``bench nav --families unseen``)."""
+WALKER_CLASSES = ("walkers-corridor", "walkers-doorway", "walkers-across")
+"""Classes with ORCA walkers between walls (``bench nav --families walkers``)."""
+ALL_CLASSES = CLASSES + WALKER_CLASSES
 FAMILY_PREFIX = "unseen-"  # a scene's name: unseen-<class>-<seed>
 RADIUS = 0.2  # the robot disc, m
 WAY_CELL = 0.025  # m: fine enough to see a gap of 2.5 robot radii
@@ -218,8 +233,92 @@ def _facing_away(rng: np.random.Generator, speed: float) -> Draw:
     return width, height, start, goal, away, obstacles
 
 
+def _walker(rng: np.random.Generator, start: list[float], goals: list[list[float]],
+            appear: float = 0.0) -> Obstacle:
+    """An ORCA agent from ``start`` through ``goals``, seeing the robot or not."""
+    return {"shape": "disc", "behavior": "orca", "center": start,
+            "radius": round(float(rng.uniform(0.2, 0.3)), 3), "goals": goals,
+            "preferred_speed": round(float(rng.uniform(0.2, 0.6)), 2),
+            "sees_robot": bool(rng.random() < 0.5), "appear": appear}
+
+
+def _apart(point: list[float], others: list[list[float]], distance: float) -> bool:
+    return all(math.dist(point, o) >= distance for o in others)
+
+
+def _walkers_corridor(rng: np.random.Generator, speed: float) -> Draw:
+    inner, length = float(rng.uniform(1.6, 2.6)), float(rng.uniform(4.0, 8.0))
+    width = float(rng.uniform(length + 5.0, length + 8.0))
+    height = float(rng.uniform(7.0, 10.0))
+    start, goal = _line(rng, width, height, slant=0.0)
+    t = 0.2
+    cx = (start[0] + goal[0]) / 2 + float(rng.uniform(-0.5, 0.5))
+    cy = start[1]
+    entry, exit_ = cx - length / 2, cx + length / 2
+    obstacles = [_box(cx, cy + inner / 2 + t / 2, length, t),
+                 _box(cx, cy - inner / 2 - t / 2, length, t)]
+    starts: list[list[float]] = [start]
+    for _ in range(int(rng.integers(1, 4))):
+        lane = cy + float(rng.uniform(-1.0, 1.0)) * (inner / 2 - 0.35)
+        x = float(rng.uniform(entry + 0.3, exit_ - 0.3))
+        if not _apart([x, lane], starts, 1.5):
+            continue
+        # toward the robot: out past the corridor's near end, beside the line; its way:
+        # out past the far end, beside the goal
+        off = float(rng.choice([-1.0, 1.0])) * float(rng.uniform(1.0, 2.0))
+        end = [entry - 1.0, cy + off] if rng.random() < 0.5 else [exit_ + 1.0, cy + off]
+        obstacles.append(_walker(rng, [x, lane], [end]))
+        starts.append([x, lane])
+    return width, height, start, goal, 0.0, obstacles
+
+
+def _walkers_doorway(rng: np.random.Generator, speed: float) -> Draw:
+    width, height = float(rng.uniform(9.0, 14.0)), float(rng.uniform(7.0, 11.0))
+    start, goal = _line(rng, width, height, slant=0.8)
+    wall_x = float(rng.uniform(0.4, 0.6)) * (start[0] + goal[0])
+    door = float(rng.uniform(1.0, 1.6))
+    line_y = (start[1] + goal[1]) / 2
+    offset = float(rng.uniform(0.0, 2.0)) * float(rng.choice([-1.0, 1.0]))
+    dy = min(max(line_y + offset, door / 2 + 0.3), height - door / 2 - 0.3)
+    low, high = dy - door / 2, dy + door / 2
+    thick = 0.2
+    far = [float(rng.uniform(wall_x + 1.5, width - 0.5)),
+           float(rng.uniform(0.7, height - 0.7))]
+    near = [float(rng.uniform(0.5, max(wall_x - 1.5, 0.6))),
+            float(rng.uniform(0.7, height - 0.7))]
+    # it sets off while the robot is still on its side of the wall
+    appear = round(float(rng.uniform(0.0, 0.6)) * (wall_x - start[0]) / speed, 1)
+    walker = _walker(rng, far, [[wall_x + 0.8, dy], [wall_x - 0.8, dy], near], appear)
+    return width, height, start, goal, 0.0, [
+        _box(wall_x, low / 2, thick, low),
+        _box(wall_x, (high + height) / 2, thick, height - high),
+        walker,
+    ]
+
+
+def _walkers_across(rng: np.random.Generator, speed: float) -> Draw:
+    width, height = float(rng.uniform(9.0, 14.0)), float(rng.uniform(7.0, 10.0))
+    start, goal = _line(rng, width, height, slant=0.6)
+    obstacles: list[Obstacle] = []
+    starts: list[list[float]] = [start, goal]
+    for _ in range(int(rng.integers(2, 5))):
+        x = float(rng.uniform(0.3, 0.8)) * (goal[0] - start[0]) + start[0]
+        reach = float(rng.uniform(1.5, 3.0))
+        line_y = start[1] + (goal[1] - start[1]) * (x - start[0]) / (goal[0] - start[0])
+        a = [x + float(rng.uniform(-0.5, 0.5)), max(line_y - reach, 0.5)]
+        b = [x + float(rng.uniform(-0.5, 0.5)), min(line_y + reach, height - 0.5)]
+        first, second = (a, b) if rng.random() < 0.5 else (b, a)
+        if not _apart(first, starts, 1.5):
+            continue
+        obstacles.append(_walker(rng, first, [second, first, second, first, second]))
+        starts.append(first)
+    return width, height, start, goal, 0.0, obstacles
+
+
 _DRAWS = {"appear": _appear, "wall-gap": _wall_gap, "cup": _cup, "corridor": _corridor,
-          "posts": _posts, "mover-stops": _mover_stops, "facing-away": _facing_away}
+          "posts": _posts, "mover-stops": _mover_stops, "facing-away": _facing_away,
+          "walkers-corridor": _walkers_corridor, "walkers-doorway": _walkers_doorway,
+          "walkers-across": _walkers_across}
 
 
 # --- turning the drawn frame -----------------------------------------------------------
@@ -278,6 +377,8 @@ def _placed(draw: Draw, quarter: int, mirror: bool) -> tuple[list[float], dict[s
             o["radius"] = round(o["radius"], 3)
         if "velocity" in o:
             o["velocity"] = vector(o["velocity"])
+        if "goals" in o:
+            o["goals"] = [point(g) for g in o["goals"]]
         placed.append(o)
     robot = {"start": s, "goal": g, "heading_deg": round(heading, 1)}
     return [round(size[0], 2), round(size[1], 2)], robot, placed
@@ -329,10 +430,10 @@ def solvable(scenario: Scenario, cell: float = WAY_CELL) -> bool:
 # --- the scenes ------------------------------------------------------------------------
 
 def unseen_scenario(kind: str, seed: int) -> Scenario:
-    """A scene of class ``kind`` (see :data:`CLASSES`), the same for the same seed."""
-    if kind not in CLASSES:
-        raise ValueError(f"unknown class {kind!r}; choose from {', '.join(CLASSES)}")
-    rng = np.random.default_rng([1012, CLASSES.index(kind), seed])
+    """A scene of class ``kind`` (see :data:`ALL_CLASSES`), the same for the same seed."""
+    if kind not in ALL_CLASSES:
+        raise ValueError(f"unknown class {kind!r}; choose from {', '.join(ALL_CLASSES)}")
+    rng = np.random.default_rng([1012, ALL_CLASSES.index(kind), seed])
     for _ in range(DRAWS):
         speed = _speed(rng)
         draw = _DRAWS[kind](rng, speed)

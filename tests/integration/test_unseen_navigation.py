@@ -1,6 +1,7 @@
 """One freshly drawn scene of each navigation class (sim/unseen.py, seed 0: scenes the
 planner was not tuned on), through `zenav run` in process: reached with no contact,
-judged on the scenario's own geometry from run.json alone."""
+judged on the scenario's own geometry from run.json alone (and, for the classes with ORCA
+walkers, on the walkers' paths the record carries)."""
 
 from __future__ import annotations
 
@@ -13,9 +14,10 @@ from typing import Any
 
 import pytest
 
+from tests.integration.test_navigation import ground_truth_clearance
 from zenav.sim.contact import clearance
 from zenav.sim.scenario import Scenario, dump_scenario, load_scenario, parse_scenario
-from zenav.sim.unseen import CLASSES, turn_point, turn_vector, unseen_scenario
+from zenav.sim.unseen import CLASSES, WALKER_CLASSES, turn_point, turn_vector, unseen_scenario
 from zenav.sim.world import World
 
 pytestmark = pytest.mark.integration
@@ -49,6 +51,15 @@ def test_unseen_scene_is_reached_without_contact(kind: str, tmp_path: Path) -> N
     scenario = load_scenario(path)
     record = zenav_run(path, tmp_path / "run")
     assert_reached_without_contact(scenario, record)
+
+
+@pytest.mark.parametrize("kind", WALKER_CLASSES)
+def test_scene_with_walkers_is_reached_without_contact(kind: str, tmp_path: Path) -> None:
+    path = dump_scenario(unseen_scenario(kind, SEED), tmp_path / f"{kind}.yaml")
+    record = zenav_run(path, tmp_path / "run")
+    assert record["outcome"] == "reached", f"{kind}: {record['outcome']} at {record['time']}"
+    assert record["agents"], "the record carries the walkers' paths"
+    assert ground_truth_clearance(path, record) > 0.0
 
 
 TURNS = ("quarter", "half", "mirror")

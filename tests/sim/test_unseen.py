@@ -9,20 +9,34 @@ from pathlib import Path
 
 import pytest
 
-from zenav.sim.scenario import Scenario, dump_scenario, load_scenario, parse_scenario
-from zenav.sim.unseen import CLASSES, RADIUS, free_grid, solvable, unseen_scenario
+from zenav.sim.scenario import (
+    ObstacleSpec,
+    Scenario,
+    dump_scenario,
+    load_scenario,
+    parse_scenario,
+)
+from zenav.sim.unseen import (
+    ALL_CLASSES,
+    CLASSES,
+    RADIUS,
+    WALKER_CLASSES,
+    free_grid,
+    solvable,
+    unseen_scenario,
+)
 
 SEEDS = range(5)
 
 
-@pytest.mark.parametrize("kind", CLASSES)
+@pytest.mark.parametrize("kind", ALL_CLASSES)
 def test_same_seed_same_scene_other_seed_other_scene(kind: str) -> None:
     first = unseen_scenario(kind, 3)
     assert unseen_scenario(kind, 3) == first
     assert unseen_scenario(kind, 4) != first
 
 
-@pytest.mark.parametrize("kind", CLASSES)
+@pytest.mark.parametrize("kind", ALL_CLASSES)
 def test_scenes_load_from_file_and_have_a_way(kind: str, tmp_path: Path) -> None:
     for seed in SEEDS:
         scene = unseen_scenario(kind, seed)
@@ -104,3 +118,45 @@ def test_free_grid_keeps_the_disc_inside_the_world() -> None:
     free = free_grid(_walled(1.0), cell=0.1)
     assert not free[:, 0].any() and not free[0, :].any()
     assert free[10, 10]
+
+
+@pytest.mark.parametrize("kind", WALKER_CLASSES)
+def test_walkers_start_clear_of_the_robot_and_walk_inside_the_world(kind: str) -> None:
+    for seed in range(20):
+        scene = unseen_scenario(kind, seed)
+        width, height = scene.world.size
+        walkers = [o for o in scene.obstacles if o.is_agent]
+        assert walkers, scene.name
+        for w in walkers:
+            assert w.goals and w.preferred_speed is not None and 0.2 <= w.preferred_speed <= 0.6
+            assert math.dist(w.center, scene.robot.start) >= 1.5, scene.name
+            for gx, gy in [w.center, *w.goals]:
+                assert 0.0 <= gx <= width and 0.0 <= gy <= height, scene.name
+
+
+def test_a_doorway_walker_goes_through_its_door_however_the_scene_is_turned() -> None:
+    for seed in range(20):
+        scene = unseen_scenario("walkers-doorway", seed)
+        walker = next(o for o in scene.obstacles if o.is_agent)
+        assert walker.goals is not None
+        (ax, ay), (bx, by) = walker.goals[0], walker.goals[1]
+        door = ((ax + bx) / 2, (ay + by) / 2)  # its first two goals face each other
+        walls = [o for o in scene.obstacles if o.shape == "box"]
+        assert len(walls) == 2
+        assert not any(inside(box, door) for box in walls), scene.name
+        # and they lie 0.8 m either side of the wall, square to it
+        assert math.isclose(math.dist((ax, ay), (bx, by)), 1.6, abs_tol=1e-2)
+        thin = 0 if walls[0].size is not None and walls[0].size[0] < walls[0].size[1] else 1
+        assert math.isclose(abs((bx - ax, by - ay)[thin]), 1.6, abs_tol=1e-2), scene.name
+
+
+def inside(box: ObstacleSpec, point: tuple[float, float]) -> bool:
+    """Whether ``point`` lies inside the axis-aligned ``box``."""
+    assert box.size is not None
+    (cx, cy), (w, h) = box.center, box.size
+    return abs(point[0] - cx) <= w / 2 and abs(point[1] - cy) <= h / 2
+
+
+def test_the_issue_classes_keep_their_scenes_beside_the_walker_classes() -> None:
+    assert ALL_CLASSES[: len(CLASSES)] == CLASSES
+    assert not set(CLASSES) & set(WALKER_CLASSES)

@@ -12,6 +12,7 @@ import pytest
 
 from zenav.bench.nav import (
     appeared_at_contact,
+    expand_families,
     goal_lines,
     never_in_view,
     no_warning,
@@ -174,3 +175,14 @@ def test_a_sweep_makes_every_run_again_unless_told_to_reuse(
     assert outcomes == {"static-0": "collision" if reuse else "reached",
                         "static-1": "reached"}
     assert ("--reuse" in report) == reuse
+
+
+def test_family_groups_stand_for_their_classes_and_unknown_names_are_refused() -> None:
+    assert expand_families(["crowd", "walkers"]) == [
+        "crowd", "unseen-walkers-corridor", "unseen-walkers-doorway", "unseen-walkers-across"]
+    assert len(expand_families(["unseen"])) == 7
+    assert "unseen-walkers-corridor" not in expand_families(["unseen"])
+    with pytest.raises(ValueError, match="unknown family walkers-corridor"):
+        expand_families(["walkers-corridor"])
+    with pytest.raises(ValueError, match="none given"):
+        expand_families([])

@@ -38,13 +38,15 @@ from zenav.engine import ENGINES
 from zenav.services.geometry import wrap_angle
 from zenav.sim.generate import FAMILIES, random_scenario
 from zenav.sim.scenario import Scenario, dump_scenario, load_scenario
-from zenav.sim.unseen import CLASSES, FAMILY_PREFIX, solvable, unseen_scenario
+from zenav.sim.unseen import CLASSES, FAMILY_PREFIX, WALKER_CLASSES, solvable, unseen_scenario
 
 TARGET_SUCCESS = 0.98  # the paper planner, on every family
 STILL_LIMIT = 10.0  # s: a run must not end with the robot standing this long while a way exists
 STILL_RADIUS = 0.05  # m: "standing still" = within this of where the run ended
 UNSEEN = tuple(FAMILY_PREFIX + c for c in CLASSES)  # scenes of the issue's classes
-KNOWN = FAMILIES + UNSEEN
+WALKERS = tuple(FAMILY_PREFIX + c for c in WALKER_CLASSES)  # ORCA walkers between walls
+GROUPS = {"unseen": UNSEEN, "walkers": WALKERS}  # --families names that stand for several
+KNOWN = FAMILIES + UNSEEN + WALKERS
 
 
 def world(family: str, seed: int) -> Scenario:
@@ -316,6 +318,19 @@ def plot(summaries: list[PlannerSummary], families: dict[str, dict[str, float]],
     draw_bench_chart(planners, outcomes, success, path)
 
 
+def expand_families(names: Sequence[str]) -> list[str]:
+    """The world families ``names`` stand for: each a family of :data:`KNOWN`, or a group
+    of :data:`GROUPS` (``unseen``, ``walkers``) for its families; ValueError on any other
+    name, or on none."""
+    families = [f for name in names for f in GROUPS.get(name, (name,))]
+    bad = [f for f in families if f not in KNOWN]
+    if bad or not families:
+        raise ValueError(f"unknown family {', '.join(bad) or '(none given)'}; choose from "
+                         f"{', '.join(KNOWN)}, unseen (the issue's classes) or walkers "
+                         f"(the {', '.join(WALKERS)} classes)")
+    return families
+
+
 def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
             families: Sequence[str] = FAMILIES, jobs: int = 2,
             progress: bool = True, echo: Callable[[str], None] = print,
@@ -338,11 +353,7 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     if unknown or not planners:
         raise ValueError(f"unknown planner {', '.join(unknown) or '(none given)'}; choose "
                          f"from {', '.join(PLANNERS)}")
-    families = [f for name in families for f in (UNSEEN if name == "unseen" else (name,))]
-    bad = [f for f in families if f not in KNOWN]
-    if bad or not families:
-        raise ValueError(f"unknown family {', '.join(bad) or '(none given)'}; choose from "
-                         f"{', '.join(KNOWN)} or unseen (all the unseen-* classes)")
+    families = expand_families(families)
     if worlds < 1:
         raise ValueError(f"--worlds must be >= 1 (got {worlds})")
     if jobs < 1:
@@ -427,7 +438,8 @@ def add_command(kinds: Any) -> None:
                      help="first seed (default 0)")
     nav.add_argument("--families", default=",".join(FAMILIES),
                      help=f"comma-separated world families (default {','.join(FAMILIES)}); "
-                     f"also {', '.join(UNSEEN)}, or unseen for all of those")
+                     f"also {', '.join(UNSEEN)}, or unseen for all of those; "
+                     f"{', '.join(WALKERS)} (ORCA walkers between walls), or walkers")
     nav.add_argument("--jobs", type=int, default=default_jobs(),
                      help="runs at a time (default: the number of cores)")
     nav.add_argument("--engine", choices=ENGINES, default="inprocess",
