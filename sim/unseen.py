@@ -36,7 +36,7 @@ tried. Pure: the same class and seed give the same scene.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -108,20 +108,44 @@ def _appear(rng: np.random.Generator, speed: float) -> Draw:
     return width, height, start, goal, 0.0, [shape]
 
 
-def _wall_gap(rng: np.random.Generator, speed: float) -> Draw:
-    width, height = float(rng.uniform(9.0, 16.0)), float(rng.uniform(7.0, 11.0))
-    start, goal = _line(rng, width, height, slant=0.8)
+class WallWithGap(NamedTuple):
+    """A wall across a world with one gap in it (``_wall_with_gap``)."""
+
+    width: float  # the world's
+    height: float
+    start: list[float]
+    goal: list[float]
+    x: float  # the wall's
+    gap_y: float  # the gap's middle
+    low: float  # the gap's ends
+    high: float
+
+    def pieces(self, thick: float) -> list[Obstacle]:
+        """The two boxes of the wall, ``thick`` m thick, either side of the gap."""
+        return [_box(self.x, self.low / 2, thick, self.low),
+                _box(self.x, (self.high + self.height) / 2, thick, self.height - self.high)]
+
+
+def _wall_with_gap(rng: np.random.Generator, width: tuple[float, float],
+                   gap: tuple[float, float], offset: tuple[float, float]) -> WallWithGap:
+    """A world (of a width drawn from ``width``, 7-11 m high) with a wall across the
+    start-goal line and a gap in it, of a width drawn from ``gap``, its middle off the
+    line by a distance drawn from ``offset``, to either side, clear of the world's edges."""
+    world_w, world_h = float(rng.uniform(*width)), float(rng.uniform(7.0, 11.0))
+    start, goal = _line(rng, world_w, world_h, slant=0.8)
     wall_x = float(rng.uniform(0.4, 0.6)) * (start[0] + goal[0])
-    gap = float(rng.uniform(0.8, 1.4))
+    size = float(rng.uniform(*gap))
     line_y = (start[1] + goal[1]) / 2
-    offset = float(rng.uniform(0.8, 2.8)) * float(rng.choice([-1.0, 1.0]))
-    gy = min(max(line_y + offset, gap / 2 + 0.3), height - gap / 2 - 0.3)
-    low, high = gy - gap / 2, gy + gap / 2
+    off = float(rng.uniform(*offset)) * float(rng.choice([-1.0, 1.0]))
+    gy = min(max(line_y + off, size / 2 + 0.3), world_h - size / 2 - 0.3)
+    return WallWithGap(world_w, world_h, start, goal, wall_x, gy, gy - size / 2,
+                       gy + size / 2)
+
+
+def _wall_gap(rng: np.random.Generator, speed: float) -> Draw:
+    w = _wall_with_gap(rng, (9.0, 16.0), (0.8, 1.4), (0.8, 2.8))
     thick = float(rng.uniform(0.15, 0.4))
-    return width, height, start, goal, 0.0, [
-        _box(wall_x, low / 2, thick, low),
-        _box(wall_x, (high + height) / 2, thick, height - high),
-    ]
+    return w.width, w.height, w.start, w.goal, 0.0, w.pieces(thick)
 
 
 def _cup(rng: np.random.Generator, speed: float) -> Draw:
@@ -140,18 +164,43 @@ def _cup(rng: np.random.Generator, speed: float) -> Draw:
     ]
 
 
-def _corridor(rng: np.random.Generator, speed: float) -> Draw:
-    inner, length = float(rng.uniform(0.9, 1.6)), float(rng.uniform(3.0, 6.0))
-    width = float(rng.uniform(length + 5.0, length + 8.0))
-    height = float(rng.uniform(6.0, 9.0))
-    start, goal = _line(rng, width, height, slant=0.0)
+class Corridor(NamedTuple):
+    """A walled corridor on a straight start-goal line (``_walled_corridor``)."""
+
+    width: float  # the world's
+    height: float
+    start: list[float]
+    goal: list[float]
+    inner: float  # m between the walls
+    cy: float  # the corridor's middle line (the start's y)
+    entry: float  # x of its near end
+    exit: float  # x of its far end
+    walls: list[Obstacle]
+
+
+def _walled_corridor(rng: np.random.Generator, inner: tuple[float, float],
+                     length: tuple[float, float], height: tuple[float, float]) -> Corridor:
+    """A world with a corridor of walls 0.2 m thick along the start-goal line (slant 0),
+    its inner width, length and the world's height drawn from the ranges given."""
+    inside, long = float(rng.uniform(*inner)), float(rng.uniform(*length))
+    world_w = float(rng.uniform(long + 5.0, long + 8.0))
+    world_h = float(rng.uniform(*height))
+    start, goal = _line(rng, world_w, world_h, slant=0.0)
     t = 0.2
     cx = (start[0] + goal[0]) / 2 + float(rng.uniform(-0.5, 0.5))
     cy = start[1]
-    entry, exit_ = cx - length / 2, cx + length / 2
+    walls = [_box(cx, cy + inside / 2 + t / 2, long, t),
+             _box(cx, cy - inside / 2 - t / 2, long, t)]
+    return Corridor(world_w, world_h, start, goal, inside, cy, cx - long / 2, cx + long / 2,
+                    walls)
+
+
+def _corridor(rng: np.random.Generator, speed: float) -> Draw:
+    c = _walled_corridor(rng, (0.9, 1.6), (3.0, 6.0), (6.0, 9.0))
+    width, height, start, goal, inner, cy = c.width, c.height, c.start, c.goal, c.inner, c.cy
+    entry, exit_ = c.entry, c.exit
     lateral = float(rng.uniform(-1.0, 1.0)) * max(0.0, inner / 2 - 0.3)
-    obstacles = [_box(cx, cy + inner / 2 + t / 2, length, t),
-                 _box(cx, cy - inner / 2 - t / 2, length, t)]
+    obstacles = list(c.walls)
     if rng.random() < 0.5:  # a follower: going the robot's way, slower than it
         v = round(speed * float(rng.uniform(0.3, 0.8)), 3)
         mx = entry + float(rng.uniform(0.3, 1.2))
@@ -247,16 +296,9 @@ def _apart(point: list[float], others: list[list[float]], distance: float) -> bo
 
 
 def _walkers_corridor(rng: np.random.Generator, speed: float) -> Draw:
-    inner, length = float(rng.uniform(1.6, 2.6)), float(rng.uniform(4.0, 8.0))
-    width = float(rng.uniform(length + 5.0, length + 8.0))
-    height = float(rng.uniform(7.0, 10.0))
-    start, goal = _line(rng, width, height, slant=0.0)
-    t = 0.2
-    cx = (start[0] + goal[0]) / 2 + float(rng.uniform(-0.5, 0.5))
-    cy = start[1]
-    entry, exit_ = cx - length / 2, cx + length / 2
-    obstacles = [_box(cx, cy + inner / 2 + t / 2, length, t),
-                 _box(cx, cy - inner / 2 - t / 2, length, t)]
+    c = _walled_corridor(rng, (1.6, 2.6), (4.0, 8.0), (7.0, 10.0))
+    start, cy, inner, entry, exit_ = c.start, c.cy, c.inner, c.entry, c.exit
+    obstacles = list(c.walls)
     starts: list[list[float]] = [start]
     for _ in range(int(rng.integers(1, 4))):
         lane = cy + float(rng.uniform(-1.0, 1.0)) * (inner / 2 - 0.35)
@@ -269,31 +311,19 @@ def _walkers_corridor(rng: np.random.Generator, speed: float) -> Draw:
         end = [entry - 1.0, cy + off] if rng.random() < 0.5 else [exit_ + 1.0, cy + off]
         obstacles.append(_walker(rng, [x, lane], [end]))
         starts.append([x, lane])
-    return width, height, start, goal, 0.0, obstacles
+    return c.width, c.height, start, c.goal, 0.0, obstacles
 
 
 def _walkers_doorway(rng: np.random.Generator, speed: float) -> Draw:
-    width, height = float(rng.uniform(9.0, 14.0)), float(rng.uniform(7.0, 11.0))
-    start, goal = _line(rng, width, height, slant=0.8)
-    wall_x = float(rng.uniform(0.4, 0.6)) * (start[0] + goal[0])
-    door = float(rng.uniform(1.0, 1.6))
-    line_y = (start[1] + goal[1]) / 2
-    offset = float(rng.uniform(0.0, 2.0)) * float(rng.choice([-1.0, 1.0]))
-    dy = min(max(line_y + offset, door / 2 + 0.3), height - door / 2 - 0.3)
-    low, high = dy - door / 2, dy + door / 2
-    thick = 0.2
-    far = [float(rng.uniform(wall_x + 1.5, width - 0.5)),
-           float(rng.uniform(0.7, height - 0.7))]
-    near = [float(rng.uniform(0.5, max(wall_x - 1.5, 0.6))),
-            float(rng.uniform(0.7, height - 0.7))]
+    w = _wall_with_gap(rng, (9.0, 14.0), (1.0, 1.6), (0.0, 2.0))  # the door: the gap
+    far = [float(rng.uniform(w.x + 1.5, w.width - 0.5)),
+           float(rng.uniform(0.7, w.height - 0.7))]
+    near = [float(rng.uniform(0.5, max(w.x - 1.5, 0.6))),
+            float(rng.uniform(0.7, w.height - 0.7))]
     # it sets off while the robot is still on its side of the wall
-    appear = round(float(rng.uniform(0.0, 0.6)) * (wall_x - start[0]) / speed, 1)
-    walker = _walker(rng, far, [[wall_x + 0.8, dy], [wall_x - 0.8, dy], near], appear)
-    return width, height, start, goal, 0.0, [
-        _box(wall_x, low / 2, thick, low),
-        _box(wall_x, (high + height) / 2, thick, height - high),
-        walker,
-    ]
+    appear = round(float(rng.uniform(0.0, 0.6)) * (w.x - w.start[0]) / speed, 1)
+    walker = _walker(rng, far, [[w.x + 0.8, w.gap_y], [w.x - 0.8, w.gap_y], near], appear)
+    return w.width, w.height, w.start, w.goal, 0.0, [*w.pieces(0.2), walker]
 
 
 def _walkers_across(rng: np.random.Generator, speed: float) -> Draw:
