@@ -158,10 +158,13 @@ def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: 
     assert codes == {name: 130 if name == "record" else 0 for name in procs}, codes
     goal = list(scenario.robot.goal)
     # The recorder, started first, is linked to each service as that service starts: the
-    # planner's first state, global path and event (all sent at its first decision, the
-    # event only then) are in the bag. The simulator sends odometry as soon as the
-    # services are alive, which can be before its link to the recorder is up on a loaded
-    # machine, so its first odometry is not required.
+    # planner's first global path and event (both sent reliably at its first decision,
+    # the event only then) are in the bag. Its state is published to be dropped, not
+    # waited for, when the link is congested (CongestionControl.DROP), and a loaded
+    # machine dropped the first one once in CI (state from seq 1, path and event from 0),
+    # so only some state is required. The simulator sends odometry as soon
+    # as the services are alive, which can be before its link to the recorder is up on a
+    # loaded machine, so its first odometry is not required either.
     kinds: dict[str, type[Message]] = {
         "odom": Odometry, "planner/state": PlannerState, "planner/path": GlobalPath,
         "planner/events": PlannerEvent}
@@ -169,8 +172,9 @@ def test_the_six_services_started_by_hand_drive_to_the_scenarios_goal(tmp_path: 
     for message in read_bag(bag, set(kinds)):
         first.setdefault(message.topic, decode(message.payload, kinds[message.topic]))
     seqs = {topic: m.seq for topic, m in first.items()}
-    assert "odom" in seqs and {topic: seqs.get(topic) for topic in kinds if topic != "odom"} \
-        == {"planner/state": 0, "planner/path": 0, "planner/events": 0}, seqs
+    assert "odom" in seqs and "planner/state" in seqs, seqs
+    assert {topic: seqs.get(topic) for topic in ("planner/path", "planner/events")} \
+        == {"planner/path": 0, "planner/events": 0}, seqs
     paths = [decode(m.payload, GlobalPath) for m in read_bag(bag, {"planner/path"})]
     assert all(path.points[-1].tolist() == goal for path in paths), paths[-1].points
     targets = [decode(m.payload, PlannerState).target for m in read_bag(bag, {"planner/state"})]
