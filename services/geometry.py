@@ -12,9 +12,45 @@ from typing import overload
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["limit_velocity", "wrap_angle", "wrap_angles", "wrap_degrees", "wrap_positive"]
+__all__ = [
+    "disc_distance",
+    "disc_mean_range",
+    "limit_velocity",
+    "wrap_angle",
+    "wrap_angles",
+    "wrap_degrees",
+    "wrap_positive",
+]
 
 FloatArray = npt.NDArray[np.float64]
+
+
+def disc_mean_range(distance: float, radius: float, n: int = 8) -> float:
+    """Mean range of the beams that hit a disc of ``radius`` whose centre is ``distance``
+    away (``n`` beams evenly spread in angle over the disc): how far from the laser the
+    paper's Eq. 5 puts the centre of a disc seen whole. It lies on the visible surface,
+    about 0.8 radius in front of the true centre."""
+    half = math.asin(min(radius / distance, 1.0))
+    total = 0.0
+    for i in range(n):
+        a = half * (2 * i + 1 - n) / n
+        s = distance * math.sin(a)
+        total += distance * math.cos(a) - math.sqrt(max(radius * radius - s * s, 0.0))
+    return total / n
+
+
+def disc_distance(mean_range: float, radius: float) -> float:
+    """The distance from the laser of the centre of a disc of ``radius`` whose Eq. 5 centre
+    lies ``mean_range`` away: :func:`disc_mean_range` inverted (the gap between the two
+    changes slowly with the distance, so fixed-point steps settle it: a few, unless
+    the disc is nearly touching the laser)."""
+    distance = mean_range + 0.25 * math.pi * radius
+    for _ in range(50):
+        step = max(mean_range + distance - disc_mean_range(distance, radius), radius) - distance
+        distance += step
+        if abs(step) < 1e-9:
+            break
+    return distance
 
 
 def wrap_angle(angle: float) -> float:

@@ -33,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
-from zenav.services.geometry import wrap_angle
+from zenav.services.geometry import disc_distance, wrap_angle
 from zenav.services.planner import safety
 from zenav.services.planner._loops import box_gaps
 from zenav.services.planner.costmap import Costmap, ScanData
@@ -977,6 +977,7 @@ class Planner:
         """One decision per scan: map -> global path -> (recovery, or the local layer:
         assess, respond, detour, speed and safety) -> stop zone -> command."""
         p = self.p
+        tracked, obstacles = obstacles, self.footprints(pose, obstacles, scan)
         for ob in obstacles:
             self.first_seen.setdefault(ob.id, stamp)
         live = {ob.id for ob in obstacles}
@@ -1005,7 +1006,10 @@ class Planner:
         if self.recovery.unreachable:
             return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
 
-        self.update_map(pose, obstacles, scan, stamp)
+        # The map leaves out the returns on the movers' visible surfaces: the tracks'
+        # own discs, centred on those surfaces, cover them (the footprints' discs only
+        # graze them, and a radius a little short would leave marks in a mover's wake).
+        self.update_map(pose, tracked, scan, stamp)
         self.settle_goal(robot)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
@@ -1051,6 +1055,30 @@ class Planner:
                     self.hold = None
                     decision = self.recover(pose, stamp, scan) or decision
         return self._record(decision)
+
+    def footprints(self, pose: tuple[float, float, float], obstacles: list[Obstacle],
+                   scan: ScanData | None) -> list[Obstacle]:
+        """The obstacles as every later stage sees them: with ``mover_centre``, each mover
+        this scan sees whole (``should_be_seen``: its disc inside the field of view,
+        nothing nearer on its middle beam) at the centre of the disc its track
+        describes. The track's point is that disc's Eq. 5 centre seen from about here,
+        so the centre lies farther along the same bearing, by ``disc_distance``. A mover
+        seen in part (cut by the edge of the view or by something in front) or not at
+        all keeps its track's point: where its centre lies is less sure, and the point
+        errs toward the robot."""
+        if not self.p.mover_centre or scan is None:
+            return obstacles
+        out = []
+        for ob in obstacles:
+            dx, dy = ob.position[0] - pose[0], ob.position[1] - pose[1]
+            seen_at = math.hypot(dx, dy)
+            if (ob.kind != "dynamic" or seen_at <= ob.radius
+                    or not should_be_seen(scan, ob.position, ob.radius)):
+                out.append(ob)
+                continue
+            k = disc_distance(seen_at, ob.radius) / seen_at
+            out.append(dataclasses.replace(ob, position=(pose[0] + dx * k, pose[1] + dy * k)))
+        return out
 
     def given_up(self, pose: tuple[float, float, float], obstacles: list[Obstacle]) -> Decision:
         """The command once the goal is unreachable: stand, unless a walker would walk

@@ -50,7 +50,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
-from zenav.services.geometry import wrap_angle
+from zenav.services.geometry import disc_mean_range, wrap_angle
 from zenav.services.perception.clustering import (
     EDGE_FREE,
     EDGE_OCCLUDED,
@@ -235,18 +235,6 @@ class _Rows:
             moved_refs=([(k, ref) for k, ref in enumerate(refs.tolist()) if math.isfinite(ref)]
                         if each is not None and refs is not None else None),
         )  # fmt: skip
-
-
-def _mean_range(d: float, r: float, n: int = 8) -> float:
-    """Mean range of the beams that hit a disc of radius ``r`` whose centre is ``d`` away
-    (beams evenly spread in angle over the disc: Eq. 5's mean rho of a whole view)."""
-    half = math.asin(min(r / d, 1.0))
-    total = 0.0
-    for i in range(n):
-        a = half * (2 * i + 1 - n) / n
-        s = d * math.sin(a)
-        total += d * math.cos(a) - math.sqrt(max(r * r - s * s, 0.0))
-    return total / n
 
 
 def _moved_since_born(rows: _Rows, c: int, born: float) -> float:
@@ -665,7 +653,7 @@ class Tracker:
         if abs(math.hypot(hx - cx, hy - cy) - r) > _FIT_SLACK:
             return None
         d = math.hypot(cx - pose[0], cy - pose[1])
-        k = _mean_range(d, r) / d
+        k = disc_mean_range(d, r) / d
         return _Measurement(
             centre=m.centre,
             point=(pose[0] + (cx - pose[0]) * k, pose[1] + (cy - pose[1]) * k),
