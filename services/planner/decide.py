@@ -1495,7 +1495,23 @@ class Planner:
                                p.map_resolution, self.lengths)
         if beyond is not None:
             return "blocked beyond the window"
+        if self._straight_way_open(robot, s0):
+            return "straight way open"
         return None
+
+    def _straight_way_open(self, robot: Vec, s0: float) -> bool:
+        """Whether the straight way from the robot to the goal is free on the map and
+        shorter than the rest of the path (from ``s0`` on) by more than
+        ``path_deviation``: the path goes round something the map no longer holds (the
+        marks of a walker standing at its start, cleared by the beams since). Nav2
+        plans again every second; a path kept while it stays free needs this test
+        instead, and one line's cells cost far less than a search."""
+        assert self.costmap is not None and self.path is not None and self.lengths is not None
+        straight = float(np.hypot(*(self.goal - robot)))
+        if float(self.lengths[-1]) - s0 - straight <= self.p.path_deviation:
+            return False
+        line = np.vstack([robot, self.goal])
+        return first_blocked(self.costmap, line, 0.0, self.p.map_resolution) is None
 
     def _blocked_within_window(self, robot: Vec, stamp: float) -> bool:
         """Whether the global path runs into what the map holds within the window, off

@@ -195,6 +195,33 @@ def test_a_wall_seen_in_the_scans_bends_the_global_path_through_its_gap() -> Non
     assert p.plan is not None and p.plan.reason == "blocked beyond the window"
 
 
+def test_a_path_round_what_the_beams_have_cleared_since_is_planned_straight_again() -> None:
+    """A walker standing at its start beyond the window leaves marks the path goes round;
+    once it has gone, the beams clear them and the straight way is open: the path is
+    planned again (at most once per ``replan_period``), not followed round nothing."""
+    p = planner(window_radius=2.0)
+    standing = [(6.5, 2.7, 6.9, 3.3)]  # on the straight line, beyond the window
+    for k in range(30):
+        p.step(POSE, [], k * 0.1, scan_of(POSE, boxes=standing))
+    assert p.path is not None and len(p.path) > 2
+    assert p.plan is not None and p.plan.reason == "blocked beyond the window"
+    rest = float(p.lengths[-1]) if p.lengths is not None else 0.0
+    assert rest > 6.0 + p.p.path_deviation  # round the marks, longer than the line
+    for k in range(30, 42):  # gone: the beams pass where it stood
+        p.step(POSE, [], k * 0.1, scan_of(POSE))
+    assert p.plan is not None and p.plan.reason == "straight way open"
+    assert len(p.path) == 2 and np.allclose(p.path, [[2.0, 3.0], [8.0, 3.0]], atol=1e-6)
+
+
+def test_a_path_round_what_the_map_still_holds_stays() -> None:
+    p = planner(window_radius=2.0)
+    standing = [(6.5, 2.7, 6.9, 3.3)]
+    for k in range(60):
+        p.step(POSE, [], k * 0.1, scan_of(POSE, boxes=standing))
+    assert p.plan is not None and p.plan.reason == "blocked beyond the window"
+    assert p.path is not None and len(p.path) > 2
+
+
 def test_with_no_scan_the_global_path_is_the_straight_line() -> None:
     p = planner()
     p.step(POSE, [], 0.0)
