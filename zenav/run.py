@@ -16,11 +16,11 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Awaitable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import Any, TypeVar
 
 from zenav.engine import PATHS_KEPT, add_path
 from zenav.launch import Stack
@@ -42,6 +42,8 @@ from zenav.services.runner import PLANNERS, service_params
 from zenav.services.transport import Latest, Subscription, ZenohBus
 from zenav.services.writable import check_output_dir
 from zenav.sim.scenario import load_scenario
+
+T = TypeVar("T")
 
 
 class RunError(RuntimeError):
@@ -235,7 +237,8 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         # The planner keeps every event it made; asking for them all does not depend on
         # this process having been subscribed before the first one.
         check()
-        history = await bus.query(k.of(keys.EVENT_HISTORY), timeout=5.0)
+        history = await _unless_stopped(bus.query(k.of(keys.EVENT_HISTORY), timeout=5.0),
+                                        stop)
         payloads = [payload for _, payload in history]
         while events_sub.pending():
             payloads.append((await events_sub.get())[1])
@@ -254,6 +257,23 @@ async def _collect(stack: Stack, progress_timeout: float, record: Path | None = 
         if recording is not None:
             recording.close()
         bus.close()
+
+
+async def _unless_stopped(work: Awaitable[T], stop: threading.Event) -> T:
+    """``work``'s result, or KeyboardInterrupt within a tenth of a second of ``stop``
+    being set. The event history query waits up to 5 s for a planner that a Ctrl-C of
+    the same batch may be stopping: ``zenav paper`` took 5 s to stop on a loaded
+    machine."""
+    task = asyncio.ensure_future(work)
+    try:
+        while True:
+            done, _ = await asyncio.wait({task}, timeout=0.1)
+            if done:
+                return task.result()
+            if stop.is_set():
+                raise KeyboardInterrupt
+    finally:
+        task.cancel()
 
 
 async def _take_paths_and_map(k: Keys, paths: Subscription, maps: Latest,

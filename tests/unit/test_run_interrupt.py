@@ -4,16 +4,22 @@ run, and a service killed by a signal is said to be so."""
 from __future__ import annotations
 
 import asyncio
+import math
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
+import numpy as np
 import pytest
 
 from zenav import run
 from zenav.launch import Stack, ended
+from zenav.schemas.codec import encode
+from zenav.schemas.messages import RunResult
 
 
 def test_how_a_process_ended_names_the_signal_that_killed_it() -> None:
@@ -96,3 +102,57 @@ def test_a_run_waiting_on_its_services_ends_when_its_batch_stops_it() -> None:
     finally:
         timer.cancel()
     assert FakeBus.closed
+
+
+class AnsweredBus(FakeBus):
+    """A bus on which every service is up and the simulator's result is in, and whose
+    event history query hangs as one to a planner being stopped does (up to 5 s)."""
+
+    asked = threading.Event()
+
+    def watch_liveliness(self, key: str, callback: Any) -> None:
+        for service in FakeStack.services:
+            callback(f"{key[:-1]}{service}", True)
+
+    def subscribe(self, key: str, depth: int = 1) -> Any:
+        result = RunResult(stamp=9.0, seq=0, scenario="s", outcome="reached", time=9.0,
+                           path_length=1.0, min_clearance=math.inf,
+                           trajectory=np.zeros((1, 5)))
+
+        class Sub:
+            async def get(self) -> tuple[str, bytes]:
+                return key, encode(result)
+
+            def pending(self) -> bool:
+                return False
+
+        return Sub()
+
+    def latest(self, key: str) -> Any:
+        return SimpleNamespace(take=lambda: None)
+
+    def declare_token(self, key: str) -> Any:
+        return SimpleNamespace(undeclare=lambda: None)
+
+    async def query(self, selector: str, timeout: float = 2.0) -> list[tuple[str, bytes]]:
+        AnsweredBus.asked.set()
+        await asyncio.sleep(timeout)
+        return []
+
+
+def test_a_run_waiting_for_the_planners_event_history_ends_when_stopped(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(run, "ZenohBus", AnsweredBus)
+    AnsweredBus.asked.clear()
+    stop = threading.Event()
+
+    def stop_once_asked() -> None:
+        if AnsweredBus.asked.wait(30):
+            stop.set()
+
+    threading.Thread(target=stop_once_asked).start()
+    began = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        collect(FakeStack(None), stop)  # without stop: the query's 5 s
+    assert AnsweredBus.asked.is_set()
+    assert time.monotonic() - began < 4.0
