@@ -1072,8 +1072,8 @@ class Planner:
         for ob in obstacles:
             dx, dy = ob.position[0] - pose[0], ob.position[1] - pose[1]
             seen_at = math.hypot(dx, dy)
-            if (ob.kind != "dynamic" or seen_at <= ob.radius
-                    or not should_be_seen(scan, ob.position, ob.radius)):
+            # (seen whole also means farther than its radius: k below is finite)
+            if ob.kind != "dynamic" or not should_be_seen(scan, ob.position, ob.radius):
                 out.append(ob)
                 continue
             k = disc_distance(seen_at, ob.radius) / seen_at
@@ -1505,7 +1505,8 @@ class Planner:
         ``path_deviation``: the path goes round something the map no longer holds (the
         marks of a walker standing at its start, cleared by the beams since). Nav2
         plans again every second; a path kept while it stays free needs this test
-        instead, and one line's cells cost far less than a search."""
+        instead. One line's cells (about 16 us) cost far less than a search, and are
+        looked at each cycle from the first one a re-plan is due."""
         assert self.costmap is not None and self.path is not None and self.lengths is not None
         straight = float(np.hypot(*(self.goal - robot)))
         if float(self.lengths[-1]) - s0 - straight <= self.p.path_deviation:
