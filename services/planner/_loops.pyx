@@ -3,15 +3,17 @@
 
 numpy ran these as one pass over whole arrays per step, which costs more in call
 overhead than in arithmetic: the map's update from a scan (its marks, a ray per beam
-over the map, about 41,000 samples a scan in the perf world, and the marking), the
-unicycle roll-out of every safety candidate over the horizon, and the collision
-prediction's gaps between the path and each standing obstacle's grid area; and the
-small ones numpy ran as a dozen calls on a few numbers each, several times a scan: the
-projection on the global path and the point at an arc length, the map's look-ups along
-a straight line and along each roll-out. Here they are plain loops with the same
-floating-point operations, in the same order, as the numpy code they replaced (angles
-wrapped by ``_angles.pxi``, ``hypot``, ``np.linspace``'s points and the floors of the
-cell indices as numpy has them), so the results are the same to the bit. The Python
+over the map, and the marking), the unicycle roll-out of every safety candidate over
+the horizon, and the collision prediction's gaps between the path and each standing
+obstacle's grid area; and the small ones numpy ran as a dozen calls on a few numbers
+each, several times a scan: the projection on the global path and the point at an arc
+length, the map's look-ups along a straight line and along each roll-out. Here they
+are plain loops with the same floating-point operations, in the same order, as the
+numpy code they replaced (angles wrapped by ``_angles.pxi``, ``hypot``,
+``np.linspace``'s points and the floors of the cell indices as numpy has them), so the
+results are the same to the bit. The ray tracing alone is not a copy: it walks each
+beam's cells one grid line at a time, where the numpy code sampled points every half
+cell (about 58,000 a scan of 361 beams out to 8 m, two divisions each). The Python
 callers (``costmap.py``, ``safety.py``, ``prediction.py``, ``global_path.py``) own the
 meaning; ``_loops.pyi`` gives their types.
 """
@@ -76,24 +78,28 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
        (rows ``(x, y, radius)`` of ``movers``: ``hypot`` to its centre minus its
        radius) or outside the grid, are the marks; ``returned`` (all 0, one byte a
        cell) flags them meanwhile and is all 0 again on return.
-    2. Clearing: every point ``s = 0, step, 2 step, ...`` (``step`` half a cell) along
-       each beam up to its reach (half a cell short of its return, never beyond
-       ``range_max``) makes its cell seen at ``stamp``, free, and no wall, unless a
-       mark falls in it.
+    2. Clearing: every cell the segment from (x, y) to the beam's reach passes through
+       (the reach: half a cell short of its return, never beyond ``range_max``) is
+       seen at ``stamp``, free, and no wall, unless a mark falls in it. The cells are
+       walked in order, one cell boundary at a time (Amanatides and Woo's traversal:
+       the distance along the beam to the next vertical and the next horizontal grid
+       line, the nearer one crossed); where the beam passes exactly through a grid
+       corner, the cell across the horizontal line comes first and the diagonal one is
+       not visited.
     3. Marking: each marked cell is seen at ``stamp`` and occupied (its occupied spell
        starting now, ``hit_since``, unless it was occupied already), and a wall once
        that spell has lasted ``confirm`` seconds.
 
-    A cell is found with the arithmetic of ``Costmap.cell_of`` (``cell_index``; along
-    the beams, the same floors of the same quotients, read off them as the comments
-    there say, and no point after a beam has left the grid: it never comes back).
+    A return's cell is found with the arithmetic of ``Costmap.cell_of``
+    (``cell_index``), and so is the robot's, where every walk starts. A walk ends at
+    its reach, or at its first cell beyond the grid after one inside it (a straight
+    line never comes back).
     """
     cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t nx = seen.shape[0] // ny
-    cdef Py_ssize_t b, m, ix, iy, cell, count = 0
+    cdef Py_ssize_t b, m, ix, iy, cell, count = 0, sx, sy, start_x, start_y
     cdef double step = resolution / 2
-    cdef double rho, reach, px, py, s, bx, by, kd, qx, qy
-    cdef double width = <double>nx, height = <double>ny
+    cdef double rho, reach, px, py, bx, by, qx, qy, tx, ty, dtx, dty
     cdef bint entered
     cdef bint clear_of_movers
     marks = np.empty(n, dtype=np.intp)
@@ -119,37 +125,59 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
         marked[count] = cell
         count += 1
         returned[cell] = 1
+    # The robot's cell, and where in it the robot stands, in cells (0 to 1 each way).
+    start_x = cell_index(x - ox, resolution)
+    start_y = cell_index(y - oy, resolution)
+    qx = (x - ox) / resolution - start_x
+    qy = (y - oy) / resolution - start_y
     for b in range(n):
         rho = ranges[b]
         reach = rho - step if rho < range_max and rho >= range_min else rho
-        if reach > range_max:  # (a nan stays nan: no point along that beam)
+        if reach > range_max:
             reach = range_max
+        if not reach >= 0.0:  # a nan, or a return nearer than half a cell: no cell
+            continue
         bx, by = ux[b], uy[b]
-        # The point's cell is (floor(qx), floor(qy)), in the grid when 0 <= qx < nx and
-        # 0 <= qy < ny (as ``cell_index`` and the bounds test have it: the floor of a
-        # quotient is in [0, n) exactly when the quotient is in [0, n), and a nan is in
-        # neither); the truncations are then the floors. Along a beam qx and qy never go
-        # back (every step is a rounded operation that keeps the order of its operand:
-        # k step, times the beam's fixed direction, plus and minus fixed offsets, divided
-        # by the resolution), so the points in the grid are one unbroken run: the first
-        # point out after one in ends the beam.
-        kd = 0.0  # k as a double (whole numbers: k * step as before)
-        s = 0.0
+        # tx, ty: the distance along the beam at which it crosses the next vertical
+        # (horizontal) grid line; dtx, dty: the distance between two such crossings.
+        if bx > 0.0:
+            sx, dtx = 1, resolution / bx
+            tx = (1.0 - qx) * dtx
+        elif bx < 0.0:
+            sx, dtx = -1, -resolution / bx
+            tx = qx * dtx
+        else:
+            sx, dtx, tx = 0, INFINITY, INFINITY
+        if by > 0.0:
+            sy, dty = 1, resolution / by
+            ty = (1.0 - qy) * dty
+        elif by < 0.0:
+            sy, dty = -1, -resolution / by
+            ty = qy * dty
+        else:
+            sy, dty, ty = 0, INFINITY, INFINITY
+        ix, iy = start_x, start_y
         entered = False
-        while s <= reach:
-            qx = (bx * s + x - ox) / resolution
-            qy = (by * s + y - oy) / resolution
-            kd += 1.0
-            s = kd * step
-            if (qx >= 0.0) & (qx < width) & (qy >= 0.0) & (qy < height):
+        while True:
+            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
                 entered = True
-                cell = <Py_ssize_t>qx * ny + <Py_ssize_t>qy
+                cell = ix * ny + iy
                 if not returned[cell]:
                     seen[cell] = stamp
                     occupied[cell] = 0
                     walls[cell] = 0
             elif entered:
                 break
+            if tx < ty:
+                if tx > reach:
+                    break
+                ix += sx
+                tx += dtx
+            else:
+                if ty > reach:
+                    break
+                iy += sy
+                ty += dty
     for m in range(count):
         returned[marked[m]] = 0
     for m in range(count):

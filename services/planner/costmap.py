@@ -2,8 +2,8 @@
 
 Beyond the paper, in the manner of Nav2's obstacle and inflation layers:
 
-- every beam clears the cells it passes through (ray tracing, all beams at once: the
-  points every half cell along each beam, up to its return or the laser's reach), but
+- every beam clears the cells it passes through (ray tracing: each beam's cells walked
+  one grid line at a time, up to half a cell short of its return or the laser's reach), but
   not a cell another return of the same scan falls in (marking wins, as in Nav2's
   obstacle layer);
 - the cell of each return is marked occupied, unless the return falls inside the disc
@@ -268,8 +268,8 @@ class Costmap:
         discs = np.asarray(movers if movers else [], dtype=np.float64).reshape(-1, 3)
         # Compiled (``_loops.trace_scan``), in three steps:
         # - the marks: the cells of the returns, except those on a mover;
-        # - free space: every half cell along each beam, stopping half a cell short of
-        #   its return (a beam with no return clears up to its reach, never beyond the
+        # - free space: every cell each beam passes through, stopping half a cell short
+        #   of its return (a beam with no return clears up to its reach, never beyond the
         #   laser's: a range above it must not make a beam endless), except the marked
         #   cells: along a straight wall, the beams that meet it at a grazing angle pass
         #   through the face cells the others return from, and clearing them would

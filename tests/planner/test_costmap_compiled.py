@@ -1,6 +1,9 @@
 """The map's compiled scan tracing (``_loops.trace_scan``, what ``Costmap.update`` calls)
 gives, to the bit, the grids of the numpy update it replaced: the marks (Eq. 1 returns,
-those on a mover left out), the ray tracing and the marking with its confirmation."""
+those on a mover left out), the clearing and the marking with its confirmation. The
+cells the compiled update walks along each beam are checked against the geometry
+(``beam_cells``), then given to the numpy update, which sampled points every half cell
+and so missed some of the cells a beam crosses at a corner."""
 
 from __future__ import annotations
 
@@ -11,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import distance_transform_edt
 
+from tests.planner.beam_cells import beam_cells as cells_of_beams
 from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import floor_quotients
 from zenav.services.planner.costmap import Costmap, ScanData
@@ -19,16 +23,18 @@ from zenav.services.planner.prediction import path_count, path_points
 Mover = tuple[float, float, float]
 
 
-def numpy_update(cm: Costmap, scan: ScanData, stamp: float,
-                 movers: list[Mover] | None = None) -> None:
-    """The update as numpy array operations (the code ``trace_scan`` replaced)."""
+def numpy_update(cm: Costmap, scan: ScanData, stamp: float, movers: list[Mover] | None,
+                 seen_now: np.ndarray) -> None:
+    """The update as numpy array operations (the code ``trace_scan`` replaced), with the
+    cells the beams clear taken from ``seen_now`` (a grid's cells seen at ``stamp``,
+    as (i, j) rows, after the same update), once checked to lie between the cells the
+    beams surely cross and those they may touch, except the returns' cells."""
     cm.now = max(cm.now, stamp)
-    x, y, heading = scan.pose
+    x, y = scan.pose[0], scan.pose[1]
     ranges = np.asarray(scan.ranges, dtype=np.float64)
     alpha = scan.angle_min + scan.angle_increment * np.arange(ranges.size)
     hit = (ranges < scan.range_max) & (ranges >= scan.range_min)
     ends = np.column_stack(to_global(scan.pose, ranges, alpha))
-    ux, uy = to_global((0.0, 0.0, heading), np.ones_like(ranges), alpha)
     cm.grow_to(np.vstack([[x, y], ends[hit]]) if hit.any() else np.array([[x, y]]),
                cm.padding / 2)
     marks = ends[hit]
@@ -41,16 +47,11 @@ def numpy_update(cm: Costmap, scan: ScanData, stamp: float,
     hits = hits[cm.inside(hits)]
     returned = np.zeros(cm.shape, dtype=bool)
     returned[hits[:, 0], hits[:, 1]] = True
-    step = cm.resolution / 2
-    reach = np.minimum(np.where(hit, ranges - step, ranges), scan.range_max)
-    count = int(np.nanmax(reach / step, initial=0.0)) + 2
-    s = np.arange(count) * step
-    along = s[None, :] <= reach[:, None]
-    px = ux[:, None] * s[None, :] + x
-    py = uy[:, None] * s[None, :] + y
-    cells = cm.cell_of(np.column_stack([px[along], py[along]]))
-    cells = cells[cm.inside(cells)]
-    cells = cells[~returned[cells[:, 0], cells[:, 1]]]
+    marked = {(int(i), int(j)) for i, j in hits}
+    crossed, touched = beam_cells(cm, scan)
+    cleared = {(int(i), int(j)) for i, j in seen_now} - marked
+    assert crossed - marked <= cleared <= touched - marked
+    cells = np.array(sorted(cleared), dtype=np.intp).reshape(-1, 2)
     cm.seen[cells[:, 0], cells[:, 1]] = stamp
     cm.occupied[cells[:, 0], cells[:, 1]] = False
     cm.walls[cells[:, 0], cells[:, 1]] = False
@@ -61,6 +62,23 @@ def numpy_update(cm: Costmap, scan: ScanData, stamp: float,
     confirmed = cm.hit_since[hits[:, 0], hits[:, 1]] <= stamp - cm.confirm
     cm.walls[hits[confirmed, 0], hits[confirmed, 1]] = True
     cm.version += 1
+
+
+def update_both(compiled: Costmap, reference: Costmap, scan: ScanData, stamp: float,
+                movers: list[Mover] | None = None) -> None:
+    compiled.update(scan, stamp, movers)
+    numpy_update(reference, scan, stamp, movers, np.argwhere(compiled.seen == stamp))
+
+
+_beam_cells: dict[tuple[object, ...], tuple[set[tuple[int, int]], set[tuple[int, int]]]] = {}
+
+
+def beam_cells(cm: Costmap, scan: ScanData) -> tuple[set[tuple[int, int]], set[tuple[int, int]]]:
+    """``beam_cells.beam_cells``, worked out once for a scan repeated on the same grid."""
+    key = (scan.pose, np.asarray(scan.ranges).tobytes(), cm.origin.tobytes(), cm.shape)
+    if key not in _beam_cells:
+        _beam_cells[key] = cells_of_beams(cm, scan)
+    return _beam_cells[key]
 
 
 def same_grids(a: Costmap, b: Costmap) -> bool:
@@ -105,8 +123,7 @@ def test_the_compiled_update_gives_the_grids_of_the_numpy_one(seed: int,
     # each scan three times over (0.3 s > confirm: its returns become walls)
     for k, (scan, movers) in enumerate(s for s in scans(rng, aligned) for _ in range(3)):
         stamp = 0.15 * k
-        compiled.update(scan, stamp, movers)
-        numpy_update(reference, scan, stamp, movers)
+        update_both(compiled, reference, scan, stamp, movers)
         assert same_grids(compiled, reference)
         marked_on_movers += len(movers)
         unconfirmed |= bool((compiled.occupied & ~compiled.walls).any())
@@ -129,8 +146,7 @@ def test_beams_that_leave_the_grid_or_start_outside_it_trace_alike(seed: int) ->
                 float(rng.uniform(-3.0, 3.0)))
         ranges = np.minimum(rng.uniform(0.2, 9.0, 181), 8.0)
         scan = ScanData(pose, ranges, -math.pi / 2, math.pi / 180, 8.0)
-        compiled.update(scan, 0.1 * k)
-        numpy_update(reference, scan, 0.1 * k)
+        update_both(compiled, reference, scan, 0.1 * k)
         assert same_grids(compiled, reference)
         outside += not compiled.inside(compiled.cell_of(np.array([pose[:2]])))[0]
     assert outside  # the robot was beyond the grid at least once
@@ -145,8 +161,7 @@ def test_a_scan_with_no_return_and_one_with_nan_ranges_trace_alike() -> None:
     ranges[40:50] = 1.5
     for stamp, r in ((0.0, np.full(91, 8.0)), (0.1, ranges)):
         scan = ScanData((0.0, 0.0, 0.3), r, -0.5, 0.01, 8.0)
-        compiled.update(scan, stamp, [(1.0, 0.0, 0.2)])
-        numpy_update(reference, scan, stamp, [(1.0, 0.0, 0.2)])
+        update_both(compiled, reference, scan, stamp, [(1.0, 0.0, 0.2)])
         assert same_grids(compiled, reference)
 
 
