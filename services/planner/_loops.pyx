@@ -64,6 +64,26 @@ def return_bounds(double x, double y, const double[::1] ux, const double[::1] uy
 
 
 @cython.cdivision(True)
+cdef inline Py_ssize_t grid_lines(double u, double q, double resolution, double* every,
+                                  double* first) noexcept nogil:
+    """Along one axis, for a beam of direction component ``u`` from a point ``q`` cells
+    into its cell (0 to 1): the step of the cell index (1, -1, or 0 along the other
+    axis), and through ``every`` and ``first`` the distance along the beam between two
+    crossings of this axis's grid lines and to the first one."""
+    if u > 0.0:
+        every[0] = resolution / u
+        first[0] = (1.0 - q) * every[0]
+        return 1
+    if u < 0.0:
+        every[0] = -resolution / u
+        first[0] = q * every[0]
+        return -1
+    every[0] = INFINITY
+    first[0] = INFINITY
+    return 0
+
+
+@cython.cdivision(True)
 def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
                const double[::1] ranges, double range_min, double range_max,
                const double[:, ::1] movers, double ox, double oy, double resolution,
@@ -99,7 +119,7 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
     cdef Py_ssize_t nx = seen.shape[0] // ny
     cdef Py_ssize_t b, m, ix, iy, cell, count = 0, sx, sy, start_x, start_y
     cdef double step = resolution / 2
-    cdef double rho, reach, px, py, bx, by, qx, qy, tx, ty, dtx, dty
+    cdef double rho, reach, px, py, qx, qy, tx, ty, dtx, dty
     cdef bint entered
     cdef bint clear_of_movers
     marks = np.empty(n, dtype=np.intp)
@@ -137,25 +157,10 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
             reach = range_max
         if not reach >= 0.0:  # a nan, or a return nearer than half a cell: no cell
             continue
-        bx, by = ux[b], uy[b]
         # tx, ty: the distance along the beam at which it crosses the next vertical
         # (horizontal) grid line; dtx, dty: the distance between two such crossings.
-        if bx > 0.0:
-            sx, dtx = 1, resolution / bx
-            tx = (1.0 - qx) * dtx
-        elif bx < 0.0:
-            sx, dtx = -1, -resolution / bx
-            tx = qx * dtx
-        else:
-            sx, dtx, tx = 0, INFINITY, INFINITY
-        if by > 0.0:
-            sy, dty = 1, resolution / by
-            ty = (1.0 - qy) * dty
-        elif by < 0.0:
-            sy, dty = -1, -resolution / by
-            ty = qy * dty
-        else:
-            sy, dty, ty = 0, INFINITY, INFINITY
+        sx = grid_lines(ux[b], qx, resolution, &dtx, &tx)
+        sy = grid_lines(uy[b], qy, resolution, &dty, &ty)
         ix, iy = start_x, start_y
         entered = False
         while True:
