@@ -22,6 +22,7 @@ import numpy as np
 
 cimport cython
 from libc.math cimport INFINITY, cos, hypot, sin, sqrt
+from libc.string cimport memcmp, memset
 
 include "../_angles.pxi"
 
@@ -238,16 +239,19 @@ def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
     ``Costmap.lethal``: occupied, seen at ``known_from`` or later, and occupied since
     ``confirmed_by`` or earlier; or a wall seen at ``wall_known_from`` or later (the
     same comparisons: a nan is neither); whether they differ from ``before`` (a grid of
-    the same size, the last lethal cells)."""
-    cdef Py_ssize_t c
-    cdef unsigned char flag, changed = 0
-    for c in range(occupied.shape[0]):
-        flag = ((occupied[c] != 0) & (seen[c] >= known_from) & (hit_since[c] <= confirmed_by)
-                | (walls[c] != 0) & (seen[c] >= wall_known_from)
-                & (seen[c] - hit_since[c] >= wall_confirm))
-        out[c] = flag
-        changed |= flag != before[c]
-    return changed != 0
+    the same size, the last lethal cells). Most cells are neither occupied nor a wall:
+    their times are not read."""
+    cdef Py_ssize_t c, n = occupied.shape[0]
+    if n == 0:
+        return False
+    memset(&out[0], 0, n)
+    for c in range(n):
+        if occupied[c] | walls[c]:
+            out[c] = ((occupied[c] != 0) & (seen[c] >= known_from)
+                      & (hit_since[c] <= confirmed_by)
+                      | (walls[c] != 0) & (seen[c] >= wall_known_from)
+                      & (seen[c] - hit_since[c] >= wall_confirm))
+    return memcmp(&out[0], &before[0], n) != 0
 
 
 def stamp_discs(const long[::1] centres, Py_ssize_t nx, Py_ssize_t ny,
