@@ -4,10 +4,10 @@
 yet import as ``zenav.schemas``, ``zenav.services`` and ``zenav.sim``: setuptools maps each
 folder onto its package name, in a regular install and in an editable one alike.
 
-A few hot loops (``services/perception/_loops.pyx``, ``services/planner/_loops.pyx``,
-``services/tracking/_loops.pyx``, and the angle wrap the first two share,
-``services/_angles.pxi``) are compiled here with Cython, at install: an install from
-source needs a C compiler.
+A few hot loops (``services/motor_bridge/_loops.pyx``, ``services/perception/_loops.pyx``,
+``services/planner/_loops.pyx``, ``services/tracking/_loops.pyx``, and the angle wrap
+the perception's and the planner's share, ``services/_angles.pxi``) are compiled here
+with Cython, at install: an install from source needs a C compiler.
 Everything else about the distribution is in ``pyproject.toml``.
 """
 
@@ -20,7 +20,7 @@ ROOTS = {"zenav": "zenav", "zenav.schemas": "schemas", "zenav.services": "servic
 
 EXTENSIONS = [Extension("zenav.services._angles", ["services/_angles.pyx"])] + [
     Extension(f"zenav.services.{name}._loops", [f"services/{name}/_loops.pyx"])
-    for name in ("perception", "planner", "tracking")]
+    for name in ("motor_bridge", "perception", "planner", "tracking")]
 
 
 def _packages() -> list[str]:

@@ -17,6 +17,7 @@ import numpy.typing as npt
 from pydantic import BaseModel, Field
 
 from zenav.services.mission import DECEL
+from zenav.services.motor_bridge._loops import zone_hit
 
 
 class StopZoneParams(BaseModel):
@@ -68,14 +69,11 @@ def zone_blocked(
     """
     if v <= 0.0:
         return False
-    r = np.asarray(ranges, dtype=np.float64)
+    r = np.ascontiguousarray(ranges, dtype=np.float64)
     cosines, sines = _beam_directions(angle_min, angle_increment, r.shape[0])
-    hit = r < range_max
-    x = r * cosines
-    y = r * sines
-    half_width = robot_radius + side_margin
-    inside = hit & (x > 0.0) & (x <= robot_radius + ahead) & (np.abs(y) <= half_width)
-    return bool(inside.any())
+    # One compiled loop over the beams, stopping at the first inside (``_loops.zone_hit``).
+    return zone_hit(r, cosines, sines, range_max, robot_radius + ahead,
+                    robot_radius + side_margin)
 
 
 @functools.lru_cache(maxsize=8)
