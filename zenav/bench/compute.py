@@ -53,51 +53,24 @@ def perf_scenario(count: int, seed: int = 0) -> Scenario:
         if len(obstacles) % 2:
             speed = rng.uniform(0.05, 0.2)
             direction = a + math.pi / 2 * rng.choice([-1.0, 1.0])
-            obstacles.append(
-                {
-                    "shape": "disc",
-                    "center": centre,
-                    "radius": round(float(rng.uniform(0.15, 0.25)), 2),
-                    "velocity": [
-                        round(speed * math.cos(direction), 3),
-                        round(speed * math.sin(direction), 3),
-                    ],
-                }
-            )
+            obstacles.append({"shape": "disc", "center": centre,
+                              "radius": round(float(rng.uniform(0.15, 0.25)), 2),
+                              "velocity": [round(speed * math.cos(direction), 3),
+                                           round(speed * math.sin(direction), 3)]})
         elif rng.random() < 0.5:
-            obstacles.append(
-                {
-                    "shape": "disc",
-                    "center": centre,
-                    "radius": round(float(rng.uniform(0.15, 0.3)), 2),
-                }
-            )
+            obstacles.append({"shape": "disc", "center": centre,
+                              "radius": round(float(rng.uniform(0.15, 0.3)), 2)})
         else:
-            obstacles.append(
-                {
-                    "shape": "box",
-                    "center": centre,
-                    "size": [round(float(rng.uniform(0.3, 0.5)), 2)] * 2,
-                }
-            )
+            obstacles.append({"shape": "box", "center": centre,
+                              "size": [round(float(rng.uniform(0.3, 0.5)), 2)] * 2})
     if len(obstacles) < count:
         raise RuntimeError(f"could not place {count} obstacles in view")
-    data = {
-        "name": f"perf-{count}",
-        "world": {"size": [22.0, 20.0], "cell": 0.5},
-        "robot": {
-            "start": robot.tolist(),
-            "heading_deg": 0.0,
-            "goal": [19.0, 10.0],
-            "speed": 0.1,
-            "radius": 0.2,
-        },
-        "laser": {"noise_std": 0.01},
-        "obstacles": obstacles,
-        "duration": 1000,
-        "seed": seed,
-    }
+    data = {"name": f"perf-{count}", "world": {"size": [22.0, 20.0], "cell": 0.5},
+            "robot": {"start": robot.tolist(), "heading_deg": 0.0, "goal": [19.0, 10.0],
+                      "speed": 0.1, "radius": 0.2},
+            "laser": {"noise_std": 0.01}, "obstacles": obstacles, "duration": 1000, "seed": seed}
     return parse_scenario(data, f"<perf-{count}>")
+
 
 
 STAGES = ("clustering", "tracking", "prediction", "morphin", "planner", "pipeline")
@@ -114,9 +87,8 @@ class ComputeResult:
     micros: dict[str, list[float]] = field(default_factory=dict)
 
 
-def _scans(
-    scenario: Scenario, params: dict[str, dict[str, Any]], pipeline: Pipeline, count: int
-) -> Iterator[tuple[int, float, Pose, tuple[float, float], Step]]:
+def _scans(scenario: Scenario, params: dict[str, dict[str, Any]], pipeline: Pipeline,
+           count: int) -> Iterator[tuple[int, float, Pose, tuple[float, float], Step]]:
     """The pipeline's steps on the first ``count`` scans of ``scenario``'s simulation
     (the robot standing), with the simulator's ticks between scans as in the in-process
     engine: (index, time, pose, velocity, step)."""
@@ -136,7 +108,8 @@ def _scans(
                 sim.step(0.0, 0.0)
 
 
-def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) -> ComputeResult:
+def time_compute(count: int, scans: int = 200, warmup: int = 10,
+                 seed: int = 0) -> ComputeResult:
     """Each stage's compute per scan, µs, on ``scans`` scans of a world with ``count``
     obstacles in view. The robot stands (so that what is in view stays in view) while the
     planner plans as if it drove; every other obstacle moves at 0.05–0.2 m/s.
@@ -145,7 +118,8 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) 
     in-process engine runs it between the simulator's ticks and as each service runs in
     its own process. In the second the shadow planner and the baselines run on what the
     pipeline gave, scan by scan: timed between their steps, the pipeline would be timed on
-    the caches they had just filled (about 80 µs more with 5 obstacles, three alternating runs)."""
+    the caches they had just filled (about 80 µs more with 5 obstacles, in three
+    alternating runs)."""
     from zenav.services.baselines import apf, dwa, vfh
     from zenav.services.baselines.common import Cycle
     from zenav.services.baselines.node import movers_of
@@ -154,9 +128,8 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) 
     scenario = perf_scenario(count, seed)
     params = stack_params(scenario, Path("perf.yaml"), "paper")
     clock = StageClock(CLOCK)
-    result = ComputeResult(
-        count, 0, 0.0, 0.0, 0, {k: [] for k in (*STAGES, "morphin_call", *BASELINES)}
-    )
+    result = ComputeResult(count, 0, 0.0, 0.0, 0,
+                           {k: [] for k in (*STAGES, "morphin_call", *BASELINES)})
     n_clusters = n_tracks = 0
     us = 1e6
     pipeline = Pipeline(params, clock, time_planner_parts=True)
@@ -164,14 +137,10 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) 
         if i < warmup:
             continue
         stages = clock.spent
-        row = {
-            "clustering": stages["perception"],
-            "tracking": stages["tracking"],
-            "prediction": stages.get("prediction", 0.0),
-            "morphin": stages.get("morphin", 0.0),
-            "planner": stages["planner"],
-            "pipeline": stages["perception"] + stages["tracking"] + stages["planner"],
-        }
+        row = {"clustering": stages["perception"], "tracking": stages["tracking"],
+               "prediction": stages.get("prediction", 0.0),
+               "morphin": stages.get("morphin", 0.0), "planner": stages["planner"],
+               "pipeline": stages["perception"] + stages["tracking"] + stages["planner"]}
         for key, value in row.items():
             result.micros[key].append(value * us)
         result.scans += 1
@@ -197,16 +166,9 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) 
         shadow.step(pose, step.obstacles, t)
         movers, remembered = movers_of(step.track_list, 0.03)
         scan = step.scan
-        cycle = Cycle(
-            ranges=scan.ranges.astype(np.float64),
-            angles=scan.angles(),
-            range_max=scan.range_max,
-            pose=pose,
-            velocity=velocity,
-            goal=scenario.robot.goal,
-            movers=movers,
-            remembered=remembered,
-        )
+        cycle = Cycle(ranges=scan.ranges.astype(np.float64), angles=scan.angles(),
+                      range_max=scan.range_max, pose=pose, velocity=velocity,
+                      goal=scenario.robot.goal, movers=movers, remembered=remembered)
         for name, baseline in baselines.items():
             b0 = CLOCK()
             baseline.step(cycle)
@@ -214,59 +176,41 @@ def time_compute(count: int, scans: int = 200, warmup: int = 10, seed: int = 0) 
                 result.micros[name].append((CLOCK() - b0) * us)
         if i >= warmup and shadow_clock.calls.get("morphin"):
             result.micros["morphin_call"].append(
-                shadow_clock.spent["morphin"] / shadow_clock.calls["morphin"] * us
-            )
+                shadow_clock.spent["morphin"] / shadow_clock.calls["morphin"] * us)
     return result
 
 
 def compute_table(results: list[ComputeResult]) -> str:
-    head = (
-        "| stage, µs per scan | "
-        + " | ".join(f"{r.obstacles} obstacles: median / p99" for r in results)
-        + " |"
-    )
+    head = "| stage, µs per scan | " + " | ".join(
+        f"{r.obstacles} obstacles: median / p99" for r in results) + " |"
     rule = "|---|" + "---|" * len(results)
-    names = {
-        "clustering": "clustering (perception)",
-        "tracking": "tracking",
-        "prediction": "collision prediction",
-        "morphin": "Morphin",
-        "morphin_call": "Morphin, per detour planned (shadow planner, see below)",
-        "planner": "planner step (all of it)",
-        "pipeline": "**whole pipeline**",
-        "vfh": "VFH step (baseline)",
-        "dwa": "DWA step (baseline)",
-        "apf": "APF step (baseline)",
-    }
+    names = {"clustering": "clustering (perception)", "tracking": "tracking",
+             "prediction": "collision prediction", "morphin": "Morphin",
+             "morphin_call": "Morphin, per detour planned (shadow planner, see below)",
+             "planner": "planner step (all of it)", "pipeline": "**whole pipeline**",
+             "vfh": "VFH step (baseline)", "dwa": "DWA step (baseline)",
+             "apf": "APF step (baseline)"}
     lines = [head, rule]
     for key in (*STAGES[:4], "morphin_call", *STAGES[4:], *BASELINES):
         cells = []
         for r in results:
             values = r.micros[key]
-            cells.append(
-                f"{fmt(statistics.median(values) if values else math.nan)} / "
-                f"{fmt(percentile(values, 99))}"
-            )
+            cells.append(f"{fmt(statistics.median(values) if values else math.nan)} / "
+                         f"{fmt(percentile(values, 99))}")
         lines.append(f"| {names[key]} | " + " | ".join(cells) + " |")
-    lines.append(
-        "| scans timed; clusters, tracks per scan; scans with Morphin; detours "
-        "planned by the shadow | "
-        + " | ".join(
-            f"{r.scans}; {r.clusters:.1f}, {r.tracks:.1f}; {r.morphin_calls}; "
-            f"{len(r.micros['morphin_call'])}"
-            for r in results
-        )
-        + " |"
-    )
+    lines.append("| scans timed; clusters, tracks per scan; scans with Morphin; detours "
+                 "planned by the shadow | " + " | ".join(
+                     f"{r.scans}; {r.clusters:.1f}, {r.tracks:.1f}; {r.morphin_calls}; "
+                     f"{len(r.micros['morphin_call'])}" for r in results) + " |")
     lines.append("")
-    lines.append(
-        "Stages are timed inside the pipeline as the services run it, in the "
-        "thread's CPU time (time.thread_time); Morphin runs "
-        "only on the scans where a detour is (re)planned. The shadow is a second "
-        "paper planner on the same inputs whose detour is dropped before each scan, "
-        "so that it plans one on every scan with a threat: the cost of one Morphin "
-        "planning. Pipeline = clustering + tracking + planner step."
-    )
+    lines.append("Stages are timed inside the pipeline as the services run it, in the "
+                 "thread's CPU time (time.thread_time), the pipeline alone with the "
+                 "simulator's ticks between scans, the shadow and the baselines in a second "
+                 "pass over the same scans; Morphin runs "
+                 "only on the scans where a detour is (re)planned. The shadow is a second "
+                 "paper planner on the same inputs whose detour is dropped before each scan, "
+                 "so that it plans one on every scan with a threat: the cost of one Morphin "
+                 "planning. Pipeline = clustering + tracking + planner step.")
     for count, target in ((5, TARGET_PIPELINE_MEDIAN_US), (20, TARGET_PIPELINE_20_MEDIAN_US)):
         found = next((r for r in results if r.obstacles == count), None)
         if found is None or not found.micros["pipeline"]:
@@ -275,14 +219,10 @@ def compute_table(results: list[ComputeResult]) -> str:
         median = statistics.median(values)
         met = verdict(median <= target)
         lines.append("")
-        lines.append(
-            f"Target: whole pipeline ≤ {target:.0f} µs median with {count} "
-            f"obstacles — measured {median:.0f} µs, p99 "
-            f"{percentile(values, 99):.0f} µs ({met})."
-        )
+        lines.append(f"Target: whole pipeline ≤ {target:.0f} µs median with {count} "
+                     f"obstacles — measured {median:.0f} µs, p99 "
+                     f"{percentile(values, 99):.0f} µs ({met}).")
         if count == 5:
-            lines.append(
-                f"Anchor: Nav2's collision monitor, {NAV2_ANCHOR_MS} ms per 360-point "
-                f"scan ({NAV2_ANCHOR_MS * 1000 / median:.1f}× the measured pipeline)."
-            )
+            lines.append(f"Anchor: Nav2's collision monitor, {NAV2_ANCHOR_MS} ms per 360-point "
+                         f"scan ({NAV2_ANCHOR_MS * 1000 / median:.1f}× the measured pipeline).")
     return "\n".join(lines)
