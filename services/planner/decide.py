@@ -51,6 +51,7 @@ from zenav.services.planner.global_path import (
     GlobalPlan,
     arc_lengths,
     first_blocked,
+    goal_clear,
     plan_path,
     point_at,
     project,
@@ -1547,12 +1548,15 @@ class Planner:
             return
         if float(np.hypot(*(self.mission_goal - robot))) > p.window_radius:
             return
-        aim = settle_point(self.costmap, self.mission_goal, robot,
-                           p.robot_radius + p.safety_margin / 2,
-                           SETTLE_REACH * p.goal_tolerance)
-        if np.array_equal(aim, self.mission_goal):  # none clear with the margin
-            aim = settle_point(self.costmap, self.mission_goal, robot, p.robot_radius,
-                               SETTLE_REACH_CLOSE * p.goal_tolerance)
+        margin = p.robot_radius + p.safety_margin / 2
+        if goal_clear(self.costmap, self.mission_goal, margin):
+            aim = self.mission_goal  # (most cycles: the goal in the open)
+        else:
+            aim = settle_point(self.costmap, self.mission_goal, robot, margin,
+                               SETTLE_REACH * p.goal_tolerance)
+            if np.array_equal(aim, self.mission_goal):  # none clear with the margin
+                aim = settle_point(self.costmap, self.mission_goal, robot, p.robot_radius,
+                                   SETTLE_REACH_CLOSE * p.goal_tolerance)
         if float(np.hypot(*(aim - self.goal))) < 1e-9:
             return
         self.goal = aim

@@ -197,47 +197,63 @@ SETTLE_BEARINGS = 36
 """Points looked at on each ring round the goal by ``settle_point`` (every 10 degrees)."""
 
 
+def _squares_near(costmap: Costmap, point: Vec, span: float) -> Vec:
+    """The lower corners (m, 2) of the lethal cells whose squares meet the box ``point``
+    ± ``span`` (every lethal cell nearer than ``span`` to the point is among them)."""
+    corners = costmap.cell_of(np.vstack([point - span, point + span]))
+    lo = np.maximum(corners[0], 0)
+    hi = np.minimum(corners[1] + 1, costmap.shape)
+    if (hi <= lo).any():
+        return np.empty((0, 2))
+    near = np.argwhere(costmap.lethal_grid()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
+    corner: Vec = costmap.origin + near * costmap.resolution
+    return corner
+
+
+def _clear_of(low: Vec, side: float, points: Vec, clearance: float) -> npt.NDArray[np.bool_]:
+    """Per point (n, 2), whether every square (lower corners ``low``, sides ``side``)
+    lies at least ``clearance`` from it."""
+    dx = np.maximum(np.maximum(low[None, :, 0] - points[:, None, 0], 0.0),
+                    points[:, None, 0] - (low[None, :, 0] + side))
+    dy = np.maximum(np.maximum(low[None, :, 1] - points[:, None, 1], 0.0),
+                    points[:, None, 1] - (low[None, :, 1] + side))
+    return np.asarray(np.hypot(dx, dy).min(axis=1) >= clearance)
+
+
+def goal_clear(costmap: Costmap, goal: Vec, clearance: float) -> bool:
+    """Whether every occupied cell's square lies at least ``clearance`` from ``goal``:
+    ``settle_point``'s answer is then the goal itself, whatever its reach."""
+    goal = np.asarray(goal, dtype=np.float64)
+    low = _squares_near(costmap, goal, clearance + costmap.resolution)
+    return len(low) == 0 or bool(_clear_of(low, costmap.resolution, goal[None, :],
+                                           clearance)[0])
+
+
 def settle_point(costmap: Costmap, goal: Vec, toward: Vec, clearance: float,
                  reach: float) -> Vec:
     """Where to stop for a goal the robot cannot stand on comfortably: the goal itself
     when every occupied cell of the map lies farther than ``clearance`` from it (a disc
-    of the robot's radius plus a margin there touches nothing); else, on the nearest of
-    the rings round the goal (half a cell apart, out to ``reach``) that has such a point,
-    the one nearest ``toward`` (the robot); the goal when no ring within ``reach`` has
-    one. A goal beside a wall is reached from the free side, within the run's tolerance,
-    instead of being driven at until the local layer turns away from the wall.
+    of the robot's radius plus a margin there touches nothing: ``goal_clear``); else, on
+    the nearest of the rings round the goal (half a cell apart, out to ``reach``) that has
+    such a point, the one nearest ``toward`` (the robot); the goal when no ring within
+    ``reach`` has one. A goal beside a wall is reached from the free side, within the
+    run's tolerance, instead of being driven at until the local layer turns away from
+    the wall.
 
     Distances are to the occupied cells' squares (the map holds a return somewhere in
     its cell, so the square is the nearest the obstacle can be); the space beyond the
     grid holds nothing known."""
     goal = np.asarray(goal, dtype=np.float64)
     r = costmap.resolution
-    span = reach + clearance + r
-    nx, ny = costmap.shape
-    lo = np.maximum(costmap.cell_of((goal - span)[None, :])[0], 0)
-    hi = np.minimum(costmap.cell_of((goal + span)[None, :])[0] + 1, (nx, ny))
-    if (hi <= lo).any():
-        return goal
-    near = np.argwhere(costmap.lethal_grid()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
-    if len(near) == 0:
-        return goal
-    low = costmap.origin + near * r  # each occupied cell's lower corner, (m, 2)
-
-    def clear(points: Vec) -> npt.NDArray[np.bool_]:
-        dx = np.maximum(np.maximum(low[None, :, 0] - points[:, None, 0], 0.0),
-                        points[:, None, 0] - (low[None, :, 0] + r))
-        dy = np.maximum(np.maximum(low[None, :, 1] - points[:, None, 1], 0.0),
-                        points[:, None, 1] - (low[None, :, 1] + r))
-        return np.asarray(np.hypot(dx, dy).min(axis=1) >= clearance)
-
-    if clear(goal[None, :])[0]:
+    low = _squares_near(costmap, goal, reach + clearance + r)
+    if len(low) == 0 or _clear_of(low, r, goal[None, :], clearance)[0]:
         return goal
     angles = np.linspace(0.0, 2.0 * math.pi, SETTLE_BEARINGS, endpoint=False)
     ring = np.column_stack([np.cos(angles), np.sin(angles)])
     step = r / 2
     for k in range(1, int(reach / step + 1e-9) + 1):
         points = goal + (k * step) * ring
-        ok = clear(points)
+        ok = _clear_of(low, r, points, clearance)
         if ok.any():
             found = points[ok]
             return np.asarray(found[int(np.argmin(np.hypot(*(found - toward).T)))])

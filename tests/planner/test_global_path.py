@@ -15,6 +15,7 @@ from zenav.services.planner.costmap import Costmap
 from zenav.services.planner.global_path import (
     arc_lengths,
     first_blocked,
+    goal_clear,
     plan_path,
     point_at,
     project,
@@ -283,3 +284,24 @@ def test_settled_points_are_clear_and_within_reach_whatever_the_wall(seed: int) 
         for r in np.arange(0.05, reach - 1e-6, 0.05):  # no nearer ring has a clear point
             assert all(cell_square_gap(cm, GOAL + r * np.array([math.cos(a), math.sin(a)]))
                        < 0.2 for a in np.linspace(0, 2 * math.pi, 36, endpoint=False))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_goal_is_clear_exactly_when_every_cell_square_lies_beyond_the_clearance(
+        seed: int) -> None:
+    """``goal_clear`` (the planner's test before it looks for a point to settle at)
+    against the distance to every occupied cell's square, one by one; and a clear goal
+    is where ``settle_point`` stops, whatever its reach."""
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, 2 * math.pi)
+    face = rng.uniform(0.0, 0.5)
+    centre = GOAL + (face + 0.25) * np.array([math.cos(angle), math.sin(angle)])
+    box = (centre[0] - 0.25, centre[1] - 0.25, centre[0] + 0.25, centre[1] + 0.25)
+    robot = GOAL - 3.0 * np.array([math.cos(angle), math.sin(angle)])
+    cm = mapped([box], poses=((*robot, angle),))
+    gap = cell_square_gap(cm, GOAL)
+    assert math.isfinite(gap)
+    for clearance in (0.05, 0.1, 0.2, 0.3, 0.45, gap, np.nextafter(gap, math.inf)):
+        assert goal_clear(cm, GOAL, clearance) == (gap >= clearance)
+        if gap >= clearance:
+            assert np.array_equal(settle_point(cm, GOAL, robot, clearance, 0.5), GOAL)
