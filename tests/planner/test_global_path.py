@@ -260,18 +260,24 @@ def test_a_goal_beside_a_wall_settles_on_the_free_side_within_reach() -> None:
     assert np.array_equal(settle_point(cm, GOAL, np.array([3.0, 4.0]), 0.2, 0.05), GOAL)
 
 
+def wall_beside_goal(seed: int, farthest: float) -> tuple[Costmap, np.ndarray]:
+    """The map of a 0.5 m box whose face lies 0 to ``farthest`` m from the goal on a
+    random side, seen from 3 m away on the other side, and the robot's place there."""
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, 2 * math.pi)
+    face = rng.uniform(0.0, farthest)
+    centre = GOAL + (face + 0.25) * np.array([math.cos(angle), math.sin(angle)])
+    box = (centre[0] - 0.25, centre[1] - 0.25, centre[0] + 0.25, centre[1] + 0.25)
+    robot = GOAL - 3.0 * np.array([math.cos(angle), math.sin(angle)])
+    return mapped([box], poses=((*robot, angle),)), robot
+
+
 @pytest.mark.parametrize("seed", range(8))
 def test_settled_points_are_clear_and_within_reach_whatever_the_wall(seed: int) -> None:
     """A wall at a random side and distance of the goal (0.0-0.3 m from it): a point
     that differs from the goal is clear by the clearance and within reach, and the one
     returned is on the nearest ring that has a clear point."""
-    rng = np.random.default_rng(seed)
-    angle = rng.uniform(0, 2 * math.pi)
-    face = rng.uniform(0.0, 0.3)
-    centre = GOAL + (face + 0.25) * np.array([math.cos(angle), math.sin(angle)])
-    box = (centre[0] - 0.25, centre[1] - 0.25, centre[0] + 0.25, centre[1] + 0.25)
-    robot = GOAL - 3.0 * np.array([math.cos(angle), math.sin(angle)])
-    cm = mapped([box], poses=((*robot, angle),))
+    cm, robot = wall_beside_goal(seed, 0.3)
     aim = settle_point(cm, GOAL, robot, 0.2, 0.25)
     if np.array_equal(aim, GOAL):
         assert cell_square_gap(cm, GOAL) >= 0.2 or all(
@@ -292,13 +298,7 @@ def test_the_goal_is_clear_exactly_when_every_cell_square_lies_beyond_the_cleara
     """``goal_clear`` (the planner's test before it looks for a point to settle at)
     against the distance to every occupied cell's square, one by one; and a clear goal
     is where ``settle_point`` stops, whatever its reach."""
-    rng = np.random.default_rng(seed)
-    angle = rng.uniform(0, 2 * math.pi)
-    face = rng.uniform(0.0, 0.5)
-    centre = GOAL + (face + 0.25) * np.array([math.cos(angle), math.sin(angle)])
-    box = (centre[0] - 0.25, centre[1] - 0.25, centre[0] + 0.25, centre[1] + 0.25)
-    robot = GOAL - 3.0 * np.array([math.cos(angle), math.sin(angle)])
-    cm = mapped([box], poses=((*robot, angle),))
+    cm, robot = wall_beside_goal(seed, 0.5)
     gap = cell_square_gap(cm, GOAL)
     assert math.isfinite(gap)
     for clearance in (0.05, 0.1, 0.2, 0.3, 0.45, gap, np.nextafter(gap, math.inf)):
