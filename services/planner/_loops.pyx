@@ -21,7 +21,7 @@ meaning; ``_loops.pyi`` gives their types.
 import numpy as np
 
 cimport cython
-from libc.math cimport INFINITY, cos, hypot, sin, sqrt
+from libc.math cimport INFINITY, cos, fma, hypot, sin, sqrt
 from libc.string cimport memcmp, memset
 
 include "../_angles.pxi"
@@ -325,17 +325,23 @@ def closed_off(const unsigned char[::1] walls, Py_ssize_t nx, Py_ssize_t ny,
     return True
 
 
+@cython.cdivision(True)
 def drive(const double[::1] headings, const double[::1] speeds, double dt, double x0,
           double y0, double theta0, double v0, double gain, double max_omega,
-          double accel, double decel, double[:, ::1] xs, double[:, ::1] ys):
-    """The unicycle of ``safety.rollout``, candidate by candidate, step by step, into
+          double accel, double decel, bint has_goal, double gx, double gy, double within,
+          double[:, ::1] xs, double[:, ::1] ys, long[::1] ends):
+    """The unicycle of ``safety.drive_out``, candidate by candidate, step by step, into
     ``xs`` and ``ys`` (n, k): the heading error wrapped as ``wrap_angles`` does, the
-    turn rate and the speed clipped to their limits."""
+    turn rate and the speed clipped to their limits. With ``has_goal``, a roll-out whose
+    point comes within ``within`` of (gx, gy) (``hypot``, as ``np.hypot``) stands there
+    for the rest of its steps; into ``ends[i]`` how many steps roll-out i drives: up to
+    and including that point, else all of them."""
     cdef double x, y, theta, v, error, omega, wanted, c
-    cdef Py_ssize_t i, k
+    cdef Py_ssize_t i, k, j, steps = xs.shape[1]
     for i in range(headings.shape[0]):
         x, y, theta, v = x0, y0, theta0, v0
-        for k in range(xs.shape[1]):
+        ends[i] = steps
+        for k in range(steps):
             error = wrap_angle(headings[i] - theta)
             omega = min(max(gain * error, -max_omega), max_omega)
             c = cos(error)
@@ -346,6 +352,26 @@ def drive(const double[::1] headings, const double[::1] speeds, double dt, doubl
             y = y + v * sin(theta) * dt
             xs[i, k] = x
             ys[i, k] = y
+            if has_goal and hypot(x - gx, y - gy) <= within:
+                ends[i] = k + 1
+                for j in range(k + 1, steps):
+                    xs[i, j] = x
+                    ys[i, j] = y
+                break
+
+
+def holding(double x, double y, const double[:, ::1] positions, const double[::1] radii,
+            const double[::1] top_speeds, const double[::1] ages, double robot_radius,
+            double margin, double growth, double[::1] out):
+    """``safety.holding`` for the robot at (x, y): into ``out[j]`` its distance to mover
+    j when that is below the mover's clearance now (robot radius + the mover's radius +
+    half the margin + growth x its top speed x its age), else inf."""
+    cdef double now, clearance
+    cdef Py_ssize_t j
+    for j in range(radii.shape[0]):
+        now = hypot(positions[j, 0] - x, positions[j, 1] - y)
+        clearance = robot_radius + radii[j] + margin / 2 + growth * top_speeds[j] * ages[j]
+        out[j] = now if now < clearance else INFINITY
 
 
 cdef inline double spaced(Py_ssize_t i, Py_ssize_t count, double length,
@@ -494,6 +520,21 @@ def c_hypot(double x, double y):
     numbers without the cost of a numpy call (``math.hypot`` rounds its own way and
     differs from it in the last bit at times)."""
     return hypot(x, y)
+
+
+def mover_numbers(double px, double py, double vx, double vy, double rx, double ry,
+                  double dx, double dy, double speed):
+    """A mover at (px, py) going (vx, vy), against the robot at (rx, ry) going along
+    (dx, dy) (unit) at ``speed``: its centre from the robot, its velocity relative to the
+    robot's, and four dot products, as ``prediction.assess_all`` takes them: rel . d
+    (how far ahead), v . d (its speed along the robot's way), w . w and rel . w (for the
+    closest approach), w the relative velocity. Each dot product is a . b = fma(a_y, b_y,
+    a_x b_x): the product of the x parts, rounded, then the y parts' product added with
+    one rounding (a fused multiply-add), as the BLAS dot product numpy called gave them."""
+    cdef double relx = px - rx, rely = py - ry
+    cdef double wx = vx - dx * speed, wy = vy - dy * speed
+    return (relx, rely, wx, wy, fma(rely, dy, relx * dx), fma(vy, dy, vx * dx),
+            fma(wy, wy, wx * wx), fma(rely, wy, relx * wx))
 
 
 @cython.cdivision(True)

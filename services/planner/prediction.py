@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import ObstacleKind, ScenarioLetter
-from zenav.services.planner._loops import box_gaps, c_hypot
+from zenav.services.planner._loops import box_gaps, c_hypot, mover_numbers
 
 MeetRule = Literal["closest", "same_time"]
 """How a crosser is found to meet the robot (e); see the module notes."""
@@ -167,13 +167,6 @@ def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
                       (dx, dy))
 
 
-def _row_dots(a: Vec, b: Vec) -> list[float]:
-    """The dot product of each row of ``a`` (n, 2) with ``b``, one row (2,) for all or one
-    per row (n, 2). numpy takes each by the routine ``a[i] @ b`` uses (BLAS's, which may
-    fuse the multiply and add), so the numbers are those to the bit."""
-    return list((a[:, None, :] @ b[..., :, None])[:, 0, 0].tolist())
-
-
 def _mover(robot: Point, heading: Point, speed: float, path_length: float,
            obstacle: Obstacle, rel: Point, along: float, along_speed: float,
            obstacle_speed: float, closest: tuple[float, float], clearance: float, *,
@@ -241,9 +234,8 @@ def assess_all(
     this for one obstacle; each answer is the one it gets alone, to the last bit). The standing
     obstacles are measured against the path all at once: the path's points
     (:func:`path_points`) and every grid area's gaps in one compiled loop
-    (``_loops.box_gaps``). The movers' vectors are
-    arrays of all of them, their dot products taken in one call each; the rest is
-    arithmetic on plain numbers, mover by mover."""
+    (``_loops.box_gaps``). Each mover's vectors and dot products are one compiled
+    call (``_loops.mover_numbers``); the rest is arithmetic on plain numbers."""
     speeds = [c_hypot(*ob.velocity) for ob in obstacles]
     standing = [i for i, ob in enumerate(obstacles)
                 if ob.kind != "dynamic" or speeds[i] < moving_speed]
@@ -263,22 +255,18 @@ def assess_all(
                                         hit, smallest, count)
     moving = sorted(set(range(len(obstacles))).difference(standing))
     if moving:
-        # The movers' vectors as arrays, their dot products all at once, the rest per mover.
-        rel = np.array([obstacles[i].position for i in moving], dtype=np.float64) - robot
-        velocity = np.array([obstacles[i].velocity for i in moving], dtype=np.float64)
-        rel_vel = velocity - direction * speed
-        along, along_speed = _row_dots(rel, direction), _row_dots(velocity, direction)
-        speed2, toward = _row_dots(rel_vel, rel_vel), _row_dots(rel, rel_vel)
-        robot_xy = (float(robot[0]), float(robot[1]))
-        heading = (float(direction[0]), float(direction[1]))
-        for k, (i, (rx, ry), relative_velocity) in enumerate(
-                zip(moving, rel.tolist(), rel_vel.tolist(), strict=True)):
+        rx, ry = float(robot[0]), float(robot[1])
+        dx, dy = float(direction[0]), float(direction[1])
+        for i in moving:
             ob = obstacles[i]
+            (px, py), (vx, vy) = ob.position, ob.velocity
+            relx, rely, wx, wy, along, along_speed, speed2, toward = mover_numbers(
+                px, py, vx, vy, rx, ry, dx, dy, speed)
             t_path = min(horizons[i], path_length / speed) if speed > 0 else horizons[i]
             found[i] = _mover(
-                robot_xy, heading, speed, path_length, ob, (rx, ry), along[k], along_speed[k],
-                speeds[i],
-                closest_approach((rx, ry), relative_velocity, speed2[k], toward[k], t_path),
+                (rx, ry), (dx, dy), speed, path_length, ob, (relx, rely), along,
+                along_speed, speeds[i],
+                closest_approach((relx, rely), (wx, wy), speed2, toward, t_path),
                 robot_radius + ob.radius + margins[i], head_on_cos=head_on_cos,
                 same_way_cos=same_way_cos, meet_rule=meet_rule, following=following[i])
     return [a for a in found if a is not None]

@@ -52,6 +52,7 @@ import numpy.typing as npt
 
 from zenav.services.geometry import wrap_angle, wrap_angles
 from zenav.services.planner._loops import contacts, drive
+from zenav.services.planner._loops import holding as holding_loop
 
 Vec = npt.NDArray[np.float64]
 Blocked = Callable[[Vec, Vec], npt.NDArray[np.bool_]]
@@ -143,53 +144,40 @@ def rollout(robot: Robot, headings: Vec, speeds: Vec, times: Vec) -> tuple[Vec, 
     ``times`` (k,), evenly spaced from one step on. A roll-out that comes within
     ``robot.arrive_within`` of ``robot.goal`` stays at the first point it does: the
     planner stops there, so what lies past the goal is never driven into."""
-    xs, ys, _ = _drive_out(robot, headings, speeds, times)
+    xs, ys, _ = drive_out(robot, headings, speeds, times)
     return xs, ys
 
 
-def _drive_out(robot: Robot, headings: Vec, speeds: Vec, times: Vec
-               ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
-    """``rollout``'s positions and ``steps_driven``'s answer for them, found once."""
+def drive_out(robot: Robot, headings: Vec, speeds: Vec, times: Vec
+              ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
+    """``rollout``'s positions, and per roll-out how many of its steps are driven: all of
+    them, or those up to the first within ``robot.arrive_within`` of ``robot.goal``,
+    where the planner stops for good; what comes after is not checked. One compiled
+    loop (``_loops.drive``)."""
     n, k = headings.shape[0], times.shape[0]
     xs = np.empty((n, k))
     ys = np.empty((n, k))
+    ends = np.empty(n, dtype=np.int64)
+    gx, gy = robot.goal if robot.goal is not None else (0.0, 0.0)
     drive(np.ascontiguousarray(headings, dtype=np.float64),
           np.ascontiguousarray(speeds, dtype=np.float64), float(times[0]), robot.x, robot.y,
           robot.heading, robot.speed, robot.heading_gain, robot.max_omega, robot.accel,
-          robot.decel, xs, ys)
-    ends = steps_driven(robot, xs, ys)
-    if int(ends.min()) < k:
-        last = np.minimum(np.arange(k)[None, :], ends[:, None] - 1)
-        xs = np.take_along_axis(xs, last, axis=1)
-        ys = np.take_along_axis(ys, last, axis=1)
+          robot.decel, robot.goal is not None, gx, gy, robot.arrive_within, xs, ys, ends)
     return xs, ys, ends
-
-
-def steps_driven(robot: Robot, xs: Vec, ys: Vec) -> npt.NDArray[np.int64]:
-    """Per roll-out (rows of ``xs``, ``ys``), how many of its steps are driven: all of
-    them, or those up to the first within ``robot.arrive_within`` of ``robot.goal``,
-    where the planner stops for good; what comes after is not checked."""
-    n, k = xs.shape
-    if robot.goal is None:
-        return np.full(n, k, dtype=np.int64)
-    there = np.hypot(xs - robot.goal[0], ys - robot.goal[1]) <= robot.arrive_within
-    ends: npt.NDArray[np.int64] = np.where(there.any(axis=1), np.argmax(there, axis=1) + 1,
-                                          k).astype(np.int64)
-    return ends
 
 
 def holding(start: tuple[float, float], movers: Movers, robot_radius: float,
             s: Settings) -> Vec:
     """Per mover: the robot's distance now (at ``start``) to it, when its clearance (of
     its age, at no time ahead) holds the robot now and ``s.from_inside`` is on; inf
-    otherwise. See ``contact_costs``."""
+    otherwise (compiled: ``_loops.holding``). See ``contact_costs``."""
     inside = np.full(len(movers), math.inf)
     if s.from_inside and len(movers):
         ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
-        now = np.hypot(movers.positions[:, 0] - start[0], movers.positions[:, 1] - start[1])
-        clearance = (robot_radius + movers.radii + s.margin / 2
-                     + s.growth * movers.top_speeds * ages)
-        inside = np.where(now < clearance, now, math.inf)
+        holding_loop(start[0], start[1], np.ascontiguousarray(movers.positions),
+                     np.ascontiguousarray(movers.radii),
+                     np.ascontiguousarray(movers.top_speeds), np.ascontiguousarray(ages),
+                     robot_radius, s.margin, s.growth, inside)
     return inside
 
 
@@ -200,7 +188,7 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
     """Per roll-out: the cost of its passes by the movers, the time of its first contact
     (inf: none) and the mover of that contact (-1: none). ``inside``: ``holding``'s
     answer for the roll-outs' common start (None: no mover holds the robot). ``ends``:
-    ``steps_driven``'s answer (None: every step); later steps are not checked.
+    ``drive_out``'s count of steps driven (None: every step); later steps are not checked.
 
     Mover j is predicted at ``positions[j] + velocities[j] t``; the robot at step t is in
     contact with it when their centres are less than the clearance apart: robot radius
@@ -292,7 +280,7 @@ def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
     """Roll out each candidate and score its passes by the movers and the map: the
     positions (n, k), the cost, the time of the first contact and its mover. ``inside``:
     ``holding``'s answer for the robot (found here when not given)."""
-    xs, ys, ends = _drive_out(robot, headings, speeds, times)
+    xs, ys, ends = drive_out(robot, headings, speeds, times)
     if inside is None:
         inside = holding((robot.x, robot.y), movers, robot.radius, s)
     cost, first_t, who = contact_costs(xs, ys, times, movers, robot.radius, s, inside, ends)

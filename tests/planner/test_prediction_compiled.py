@@ -2,16 +2,19 @@
 numpy code it replaced: the compiled gap of path points to grid boxes
 (``_loops.box_gaps``, what ``prediction.assess_all`` calls for the standing obstacles,
 making the points of ``path_points`` itself),
-the C library's ``hypot`` for two numbers (``_loops.c_hypot``) and the movers' dot
-products taken all at once (``prediction._row_dots``)."""
+the C library's ``hypot`` for two numbers (``_loops.c_hypot``); and a mover's vectors and
+dot products (``_loops.mover_numbers``), each dot product a fused multiply-add, checked
+against exact rational arithmetic."""
 
 from __future__ import annotations
+
+from fractions import Fraction
 
 import numpy as np
 import pytest
 
-from zenav.services.planner._loops import box_gaps, c_hypot
-from zenav.services.planner.prediction import _row_dots, path_points
+from zenav.services.planner._loops import box_gaps, c_hypot, mover_numbers
+from zenav.services.planner.prediction import path_points
 
 
 def numpy_box_gaps(points: np.ndarray, cells: np.ndarray, cell: float,
@@ -87,12 +90,21 @@ def test_c_hypot_is_numpys_hypot() -> None:
     assert c_hypot(*xy[0]) == float(np.hypot(*xy[0]))  # and on numpy scalars
 
 
-@pytest.mark.parametrize("rows", [1, 2, 5, 20])
-def test_row_dots_are_the_dots_one_by_one(rows: int) -> None:
-    """Each is ``a[i] @ b`` to the bit (numpy may fuse a multiply and an add in its dot
-    product, so plain arithmetic on numbers would not do)."""
-    rng = np.random.default_rng(rows)
-    for _ in range(300):
-        a, b, one = rng.normal(size=(rows, 2)), rng.normal(size=(rows, 2)), rng.normal(size=2)
-        assert _row_dots(a, b) == [float(a[i] @ b[i]) for i in range(rows)]
-        assert _row_dots(a, one) == [float(a[i] @ one) for i in range(rows)]
+def fused_dot(a: tuple[float, float], b: tuple[float, float]) -> float:
+    """a . b as ``mover_numbers`` defines it: a_x b_x rounded, plus a_y b_y, rounded once."""
+    return float(Fraction(a[1]) * Fraction(b[1]) + Fraction(a[0] * b[0]))
+
+
+def test_mover_numbers_are_their_definition() -> None:
+    rng = np.random.default_rng(11)
+    for _ in range(2000):
+        p, v, r = rng.normal(size=2) * 4, rng.normal(size=2), rng.normal(size=2) * 3
+        d = rng.normal(size=2)
+        d /= np.hypot(*d)
+        speed = float(rng.uniform(0.0, 1.2))
+        rel = (float(p[0] - r[0]), float(p[1] - r[1]))
+        w = (float(v[0] - d[0] * speed), float(v[1] - d[1] * speed))
+        dd, vv = (float(d[0]), float(d[1])), (float(v[0]), float(v[1]))
+        got = mover_numbers(*p.tolist(), *v.tolist(), *r.tolist(), *dd, speed)
+        assert got == (*rel, *w, fused_dot(rel, dd), fused_dot(vv, dd), fused_dot(w, w),
+                       fused_dot(rel, w))

@@ -224,8 +224,7 @@ def test_a_roll_out_stops_at_the_goal() -> None:
     """Past the point where it comes within ``arrive_within`` of the goal, a roll-out
     stands there: the planner stops for good at that distance."""
     near_goal = dataclasses.replace(robot(speed=1.0), goal=(1.0, 0.0), arrive_within=0.15)
-    xs, ys = safety.rollout(near_goal, np.array([0.0]), np.array([1.0]), times())
-    ends = safety.steps_driven(near_goal, xs, ys)
+    xs, ys, ends = safety.drive_out(near_goal, np.array([0.0]), np.array([1.0]), times())
     arrival = int(ends[0]) - 1
     assert 0.85 <= xs[0, arrival] <= 1.0 and xs[0, arrival - 1] < 0.85
     assert np.all(xs[0, arrival:] == xs[0, arrival]) and np.all(ys[0] == 0.0)

@@ -72,15 +72,15 @@ def random_case(seed: int, candidates: int
                              float(rng.uniform(-2.0, 2.0)), float(rng.uniform(-2.0, 2.0))),
                          arrive_within=float(rng.uniform(0.15, 0.8)))
     times = s.step * np.arange(1, round(s.horizon / s.step) + 1, dtype=np.float64)
-    xs, ys = safety.rollout(robot, rng.uniform(-math.pi, math.pi, candidates),
-                            rng.uniform(0.0, 1.0, candidates), times)
+    xs, ys, ends = safety.drive_out(robot, rng.uniform(-math.pi, math.pi, candidates),
+                                    rng.uniform(0.0, 1.0, candidates), times)
     m = int(rng.integers(0, 12))
     velocities = rng.uniform(-1.2, 1.2, (m, 2))
     movers = safety.Movers(rng.uniform(-4.0, 4.0, (m, 2)), velocities,
                            rng.uniform(0.15, 0.4, m),
                            np.hypot(velocities[:, 0], velocities[:, 1]) * rng.uniform(1, 1.5, m),
                            None if rng.integers(0, 2) else rng.uniform(0.0, 2.0, m))
-    return xs, ys, times, movers, s, safety.steps_driven(robot, xs, ys)
+    return xs, ys, times, movers, s, ends
 
 
 @pytest.mark.parametrize("from_inside", [False, True])
@@ -132,3 +132,47 @@ def test_some_random_roll_outs_stop_at_the_goal() -> None:
         short += int((ends < xs.shape[1]).sum())
         whole += int((ends == xs.shape[1]).sum())
     assert short >= 20 and whole >= 20
+
+
+def numpy_arrival(robot: safety.Robot, xs: Vec, ys: Vec
+                  ) -> tuple[Vec, Vec, npt.NDArray[np.int64]]:
+    """Where roll-outs driven with no goal stop once they reach ``robot.goal``, as numpy
+    array operations (the code the compiled ``drive`` replaced): the steps driven, and
+    each later step at the point of arrival."""
+    k = xs.shape[1]
+    assert robot.goal is not None
+    there = np.hypot(xs - robot.goal[0], ys - robot.goal[1]) <= robot.arrive_within
+    ends = np.where(there.any(axis=1), np.argmax(there, axis=1) + 1, k).astype(np.int64)
+    last = np.minimum(np.arange(k)[None, :], ends[:, None] - 1)
+    return (np.take_along_axis(xs, last, axis=1), np.take_along_axis(ys, last, axis=1),
+            ends)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_drive_out_stops_where_the_numpy_code_did(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    goal = (float(rng.uniform(-2.0, 2.0)), float(rng.uniform(-2.0, 2.0)))
+    robot = safety.Robot(x=0.0, y=0.0, heading=float(rng.uniform(-math.pi, math.pi)),
+                         speed=float(rng.uniform(0.0, 1.0)), radius=0.3, max_speed=1.0,
+                         max_omega=1.0, heading_gain=1.5, accel=0.5, decel=1.0, goal=goal,
+                         arrive_within=float(rng.uniform(0.15, 0.8)))
+    times = 0.2 * np.arange(1, 26, dtype=np.float64)
+    headings, speeds = rng.uniform(-math.pi, math.pi, 37), rng.uniform(0.0, 1.0, 37)
+    free = safety.drive_out(dataclasses.replace(robot, goal=None), headings, speeds, times)
+    assert (free[2] == len(times)).all()
+    got = safety.drive_out(robot, headings, speeds, times)
+    for a, b in zip(got, numpy_arrival(robot, free[0], free[1]), strict=True):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_holding_is_the_numpy_arithmetic(seed: int) -> None:
+    _, _, _, movers, s, _ = random_case(seed, 1)
+    s = dataclasses.replace(s, from_inside=True)
+    start = (0.05 * seed - 1.0, 0.5)
+    ages = np.zeros(len(movers)) if movers.ages is None else movers.ages
+    now = np.hypot(movers.positions[:, 0] - start[0], movers.positions[:, 1] - start[1])
+    clearance = 0.3 + movers.radii + s.margin / 2 + s.growth * movers.top_speeds * ages
+    want = np.where(now < clearance, now, math.inf)
+    got = safety.holding(start, movers, 0.3, s)
+    assert got.dtype == want.dtype and got.tobytes() == want.tobytes()
