@@ -46,6 +46,19 @@ def floor_quotients(const double[::1] offsets, double resolution, long[::1] out)
         out[i] = cell_index(offsets[i], resolution)
 
 
+def beam_directions(double heading, const double[::1] alpha, double[::1] ux,
+                    double[::1] uy):
+    """Each beam's unit direction in the global frame: Eq. 1 at rho = 1 m from the
+    origin, (0 + 1 cos(heading + alpha), 0 + 1 sin(heading + alpha)), as
+    ``clustering.to_global((0, 0, heading), 1.0, alpha)`` computes it."""
+    cdef Py_ssize_t i
+    cdef double a
+    for i in range(alpha.shape[0]):
+        a = heading + alpha[i]
+        ux[i] = 0.0 + cos(a)
+        uy[i] = 0.0 + sin(a)
+
+
 def return_bounds(double x, double y, const double[::1] ux, const double[::1] uy,
                   const double[::1] ranges, double range_min, double range_max):
     """(x_lo, y_lo, x_hi, y_hi): the box of the robot at (x, y) and every return
@@ -454,6 +467,31 @@ def project_on(const double[:, ::1] points, const double[::1] lengths, double px
         if k == 0 or d < best_d or (d != d and best_d == best_d):  # the first nan wins
             best, best_d, best_t, best_l2 = k, d, t, l2
     return lengths[best] + best_t * sqrt(best_l2), best_d
+
+
+@cython.cdivision(True)
+def straight_on(const double[:, ::1] points, const double[::1] lengths, double s0,
+                double rx, double ry, double dx, double dy):
+    """How far the path (``points``, arc ``lengths``) runs on straight from (rx, ry)
+    along (dx, dy) (unit), from arc length ``s0`` on (the robot's projection): the
+    distance to the last vertex past ``s0 + 1e-6`` before the first whose leg from
+    (rx, ry) turns off the direction (cosine under 0.999; a vertex within 1e-9 m never
+    does), 0 when the first one does. The cosine is the dot product over ``hypot``,
+    the dot product a fused multiply-add (fma(l_y, d_y, l_x d_x), numpy's ``@`` here)."""
+    cdef Py_ssize_t i = 0, n = points.shape[0]
+    cdef double lx, ly, d
+    cdef double end = 0.0
+    while i < n and lengths[i] <= s0 + 1e-6:
+        i += 1
+    while i < n:
+        lx = points[i, 0] - rx
+        ly = points[i, 1] - ry
+        d = hypot(lx, ly)
+        if d > 1e-9 and fma(ly, dy, lx * dx) / d < 0.999:
+            break
+        end = d
+        i += 1
+    return end
 
 
 def point_on(const double[:, ::1] points, const double[::1] lengths, double s):

@@ -56,6 +56,7 @@ from zenav.services.planner.global_path import (
     point_at,
     project,
     settle_point,
+    straight_ahead,
 )
 from zenav.services.planner.morphin import Mover, cells_on_segment, choose_detour
 from zenav.services.planner.params import Params
@@ -366,16 +367,7 @@ class Planner:
         on one that goes round what the map holds."""
         if self.path is None or self.lengths is None or len(self.path) <= 2:
             return float(np.hypot(*(self.goal - robot)))
-        s0 = project(self.path, robot, self.lengths)[0]
-        k = int(np.searchsorted(self.lengths, s0 + 1e-6, side="right"))
-        end = 0.0
-        for vertex in self.path[k:]:
-            leg = vertex - robot
-            d = float(np.hypot(*leg))
-            if d > 1e-9 and float(leg @ direction) / d < 0.999:
-                break
-            end = d
-        return end
+        return straight_ahead(self.path, robot, direction, self.lengths)
 
     def _chord_clear(self, robot: Vec, point: Vec) -> bool:
         """Whether the straight way to ``point`` is free on the map (True without one)."""

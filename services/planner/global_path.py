@@ -19,7 +19,13 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from zenav.services.planner._loops import line_any, max_along, point_on, project_on
+from zenav.services.planner._loops import (
+    line_any,
+    max_along,
+    point_on,
+    project_on,
+    straight_on,
+)
 from zenav.services.planner.costmap import Costmap
 from zenav.services.planner.field import grid_distances
 
@@ -278,6 +284,17 @@ def project(points: Vec, p: Vec, lengths: Vec | None = None) -> tuple[float, flo
     s = arc_lengths(points) if lengths is None else lengths
     return project_on(np.ascontiguousarray(points, dtype=np.float64), s, float(p[0]),
                       float(p[1]))
+
+
+def straight_ahead(points: Vec, p: Vec, direction: Vec, lengths: Vec) -> float:
+    """How far the path runs on from ``p`` in ``direction`` (unit) before it bends: the
+    distance to the last vertex ahead of ``p``'s projection whose leg from ``p`` keeps
+    within about 2.6 degrees of the direction (cosine 0.999), 0 when the first one does
+    not; in compiled code (``_loops.straight_on``). ``lengths``: the path's
+    ``arc_lengths``."""
+    s0 = project(points, p, lengths)[0]
+    return straight_on(np.ascontiguousarray(points, dtype=np.float64), lengths, s0,
+                       float(p[0]), float(p[1]), float(direction[0]), float(direction[1]))
 
 
 def point_at(points: Vec, s: float, lengths: Vec | None = None) -> Vec:

@@ -107,3 +107,50 @@ def test_the_shortcut_keeps_the_vertices_of_the_numpy_tests(
     expected = shortcut(free, costmap, points, cost)
     assert len(expected) < len(points)  # it did cut something
     np.testing.assert_array_equal(compiled, expected)
+
+
+def numpy_straight_ahead(points: Vec, p: Vec, direction: Vec) -> float:
+    """How far the path runs on straight from ``p``, as the numpy loop ``straight_ahead``
+    replaced computed it, vertex by vertex."""
+    lengths = global_path.arc_lengths(points)
+    s0 = global_path.project(points, p, lengths)[0]
+    end = 0.0
+    for vertex in points[int(np.searchsorted(lengths, s0 + 1e-6, side="right")):]:
+        leg = vertex - p
+        d = float(np.hypot(*leg))
+        if d > 1e-9 and float(leg @ direction) / d < 0.999:
+            break
+        end = d
+    return end
+
+
+def test_straight_ahead_stops_at_the_bend() -> None:
+    """An L: along its first leg the way runs straight to the corner; past the corner,
+    to the end; heading off the leg, not at all."""
+    path = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]])
+    lengths = global_path.arc_lengths(path)
+    east, north = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    assert global_path.straight_ahead(path, np.array([1.0, 0.0]), east, lengths) == 3.0
+    assert global_path.straight_ahead(path, np.array([4.0, 1.0]), north, lengths) == 2.0
+    assert global_path.straight_ahead(path, np.array([1.0, 0.0]), north, lengths) == 0.0
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_straight_ahead_is_the_numpy_loop(seed: int) -> None:
+    rng = np.random.default_rng(300 + seed)
+    seen = set()
+    for _ in range(300):
+        # paths that run nearly straight for a while, then bend
+        turns = rng.choice([0.0, 0.0005, 0.01, 0.5], size=int(rng.integers(1, 7)))
+        angles = np.cumsum(turns * rng.choice([-1.0, 1.0], size=turns.size))
+        legs = rng.uniform(0.2, 2.0, turns.size)[:, None] * np.column_stack(
+            [np.cos(angles), np.sin(angles)])
+        path = np.vstack([[0.0, 0.0], np.cumsum(legs, axis=0)])
+        p = path[0] + rng.normal(0.0, 0.05, 2) + rng.uniform(0.0, 1.0) * (path[1] - path[0])
+        direction = path[-1] - p if rng.random() < 0.5 else path[1] - p
+        direction = direction / np.hypot(*direction)
+        got = global_path.straight_ahead(path, p, direction, global_path.arc_lengths(path))
+        want = numpy_straight_ahead(path, p, direction)
+        assert got == want
+        seen.add(want == 0.0)
+    assert seen == {True, False}
