@@ -43,6 +43,7 @@ cheapest candidate is driven for this cycle, and the next cycle checks again.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -270,8 +271,16 @@ def keeps_clear(robot: Robot, proposal: tuple[float, float], movers: Movers,
 
 def _times(s: Settings) -> Vec:
     """The roll-out times: every ``step`` s from one step to the horizon."""
-    steps = max(round(s.horizon / s.step), 1)
-    return s.step * np.arange(1, steps + 1, dtype=np.float64)
+    return _steps(s.horizon, s.step)
+
+
+@functools.lru_cache(maxsize=8)
+def _steps(horizon: float, step: float) -> Vec:
+    """``_times`` for one horizon and step, made once (read-only: it is shared)."""
+    steps = max(round(horizon / step), 1)
+    times = step * np.arange(1, steps + 1, dtype=np.float64)
+    times.flags.writeable = False
+    return times
 
 
 def _score(robot: Robot, headings: Vec, speeds: Vec, times: Vec, movers: Movers,
