@@ -560,6 +560,11 @@ def c_hypot(double x, double y):
     return hypot(x, y)
 
 
+def fused_dot(double ax, double ay, double bx, double by):
+    """a . b = fma(a_y, b_y, a_x b_x), as ``mover_numbers`` takes its dot products."""
+    return fma(ay, by, ax * bx)
+
+
 def mover_numbers(double px, double py, double vx, double vy, double rx, double ry,
                   double dx, double dy, double speed):
     """A mover at (px, py) going (vx, vy), against the robot at (rx, ry) going along

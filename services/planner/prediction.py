@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 
 from zenav.schemas.messages import ObstacleKind, ScenarioLetter
-from zenav.services.planner._loops import box_gaps, c_hypot, mover_numbers
+from zenav.services.planner._loops import box_gaps, c_hypot, fused_dot, mover_numbers
 
 MeetRule = Literal["closest", "same_time"]
 """How a crosser is found to meet the robot (e); see the module notes."""
@@ -152,16 +152,15 @@ def line_crossing(d: Point, rel: Point, u: Point) -> tuple[float, float] | None:
     return s, q
 
 
-def _on_the_path(robot: Vec, direction: Vec, speed: float, path_length: float,
+def _on_the_path(robot: Point, direction: Point, speed: float, path_length: float,
                  obstacle: Obstacle, first: int, least: float, count: int) -> Assessment:
     """(b) for a standing obstacle on the path, from the gaps (m, clearance taken off)
     between its grid area and each of the ``count`` points along the path: ``first``,
     the index of the first negative one, and ``least``, the smallest."""
-    along = float((np.asarray(obstacle.position, dtype=np.float64) - robot) @ direction)
+    (rx, ry), (dx, dy) = robot, direction
+    along = fused_dot(obstacle.position[0] - rx, obstacle.position[1] - ry, dx, dy)
     s_hit = first * path_length / (count - 1)
     centre_s = min(max(along, 0.0), path_length)
-    rx, ry = robot.tolist()
-    dx, dy = direction.tolist()
     return Assessment(obstacle, "b", True, (rx + dx * centre_s, ry + dy * centre_s), s_hit,
                       s_hit / speed if speed > 0 else math.inf, math.inf, least, along, 0.0,
                       (dx, dy))
@@ -240,25 +239,25 @@ def assess_all(
     standing = [i for i, ob in enumerate(obstacles)
                 if ob.kind != "dynamic" or speeds[i] < moving_speed]
     found: list[Assessment | None] = [None] * len(obstacles)
+    rx, ry = float(robot[0]), float(robot[1])
+    dx, dy = float(direction[0]), float(direction[1])
     if standing:
         count = path_count(path_length, cell / 4)
         first = np.empty(len(standing), dtype=np.int64)
         least = np.empty(len(standing), dtype=np.float64)
-        box_gaps(float(robot[0]), float(robot[1]), float(direction[0]), float(direction[1]),
-                 path_length, count,
+        box_gaps(rx, ry, dx, dy, path_length, count,
                  np.array([obstacles[i].cells for i in standing], dtype=np.int64), cell,
                  np.array([robot_radius + margins[i] for i in standing], dtype=np.float64),
                  first, least)
         for i, hit, smallest in zip(standing, first.tolist(), least.tolist(), strict=True):
             if hit >= 0:
-                found[i] = _on_the_path(robot, direction, speed, path_length, obstacles[i],
+                found[i] = _on_the_path((rx, ry), (dx, dy), speed, path_length, obstacles[i],
                                         hit, smallest, count)
-    moving = sorted(set(range(len(obstacles))).difference(standing))
-    if moving:
-        rx, ry = float(robot[0]), float(robot[1])
-        dx, dy = float(direction[0]), float(direction[1])
-        for i in moving:
-            ob = obstacles[i]
+    if len(standing) < len(obstacles):
+        still = set(standing)
+        for i, ob in enumerate(obstacles):
+            if i in still:
+                continue
             (px, py), (vx, vy) = ob.position, ob.velocity
             relx, rely, wx, wy, along, along_speed, speed2, toward = mover_numbers(
                 px, py, vx, vy, rx, ry, dx, dy, speed)

@@ -13,7 +13,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from zenav.services.planner._loops import box_gaps, c_hypot, mover_numbers
+from zenav.services.planner._loops import box_gaps, c_hypot, fused_dot, mover_numbers
 from zenav.services.planner.prediction import path_points
 
 
@@ -90,7 +90,7 @@ def test_c_hypot_is_numpys_hypot() -> None:
     assert c_hypot(*xy[0]) == float(np.hypot(*xy[0]))  # and on numpy scalars
 
 
-def fused_dot(a: tuple[float, float], b: tuple[float, float]) -> float:
+def fused_dot_exact(a: tuple[float, float], b: tuple[float, float]) -> float:
     """a . b as ``mover_numbers`` defines it: a_x b_x rounded, plus a_y b_y, rounded once."""
     return float(Fraction(a[1]) * Fraction(b[1]) + Fraction(a[0] * b[0]))
 
@@ -106,5 +106,12 @@ def test_mover_numbers_are_their_definition() -> None:
         w = (float(v[0] - d[0] * speed), float(v[1] - d[1] * speed))
         dd, vv = (float(d[0]), float(d[1])), (float(v[0]), float(v[1]))
         got = mover_numbers(*p.tolist(), *v.tolist(), *r.tolist(), *dd, speed)
-        assert got == (*rel, *w, fused_dot(rel, dd), fused_dot(vv, dd), fused_dot(w, w),
-                       fused_dot(rel, w))
+        assert got == (*rel, *w, fused_dot_exact(rel, dd), fused_dot_exact(vv, dd),
+                       fused_dot_exact(w, w), fused_dot_exact(rel, w))
+
+
+def test_fused_dot_is_its_definition() -> None:
+    rng = np.random.default_rng(12)
+    for a, b in zip(rng.normal(size=(3000, 2)) * 5, rng.normal(size=(3000, 2)), strict=True):
+        ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+        assert fused_dot(ax, ay, bx, by) == fused_dot_exact((ax, ay), (bx, by))
