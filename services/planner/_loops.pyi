@@ -16,6 +16,9 @@ def trace_scan(x: float, y: float, ux: _F, uy: _F, ranges: _F, range_min: float,
                range_max: float, movers: _F, ox: float, oy: float, resolution: float,
                ny: int, returned: _U8, stamp: float, confirm: float, seen: _F,
                occupied: _U8, hit_since: _F, walls: _U8) -> None: ...
+def returns_near(occupied: _U8, seen: _F, ny: int, i0: int, i1: int, j0: int, j1: int,
+                 since: float, ox: float, oy: float, resolution: float, ax: float, ay: float,
+                 bx: float, by: float, distance: float) -> bool: ...
 def look_up(points: _F, ox: float, oy: float, resolution: float, grid: _U8, ny: int,
             outside: int, out: _U8) -> None: ...
 def look_up_rows(xs: _F, ys: _F, ox: float, oy: float, resolution: float, grid: _U8,

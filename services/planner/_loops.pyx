@@ -209,6 +209,37 @@ def trace_scan(double x, double y, const double[::1] ux, const double[::1] uy,
             walls[cell] = 1
 
 
+@cython.cdivision(True)
+def returns_near(const unsigned char[::1] occupied, const double[::1] seen, Py_ssize_t ny,
+                 Py_ssize_t i0, Py_ssize_t i1, Py_ssize_t j0, Py_ssize_t j1, double since,
+                 double ox, double oy, double resolution, double ax, double ay, double bx,
+                 double by, double distance):
+    """Whether a cell of columns ``i0..i1 - 1`` and rows ``j0..j1 - 1`` of the flat grids
+    (``ny`` cells a column) is occupied and was seen at ``since`` or later, with its
+    centre (``Costmap.centre_of``) within ``distance`` of the segment from (ax, ay) to
+    (bx, by): the nearest point of the segment at the clipped projection of the centre
+    on it, its gap by ``hypot``. An infinite ``distance`` asks only for such a cell."""
+    cdef Py_ssize_t i, j, cell
+    cdef double dx = bx - ax, dy = by - ay
+    cdef double length2 = dx * dx + dy * dy
+    cdef double rx, ry, t
+    for i in range(i0, i1):
+        for j in range(j0, j1):
+            cell = i * ny + j
+            if not occupied[cell] or not seen[cell] >= since:
+                continue
+            if distance == INFINITY:
+                return True
+            rx = ox + (<double>i + 0.5) * resolution - ax
+            ry = oy + (<double>j + 0.5) * resolution - ay
+            t = 0.0
+            if length2 > 0.0:
+                t = min(max((rx * dx + ry * dy) / length2, 0.0), 1.0)
+            if hypot(rx - t * dx, ry - t * dy) <= distance:
+                return True
+    return False
+
+
 def look_up(const double[:, ::1] points, double ox, double oy, double resolution,
             const unsigned char[::1] grid, Py_ssize_t ny, unsigned char outside,
             unsigned char[::1] out):

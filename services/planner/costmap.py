@@ -60,6 +60,7 @@ from zenav.services.planner._loops import (
     look_up,
     look_up_rows,
     return_bounds,
+    returns_near,
     stamp_discs,
     trace_scan,
 )
@@ -349,18 +350,18 @@ class Costmap:
                           & (self.hit_since <= self.now - self.confirm)
                           | self._kept_walls())
 
-    def _returns_in(self, lo: Vec, hi: Vec) -> tuple[npt.NDArray[np.int64], tuple[slice, slice]]:
-        """The first cell of the part of the grid the box ``lo``..``hi`` (m) covers, and
-        that part's slices (empty when the box misses the grid)."""
+    def _returns_in(self, lo: Vec, hi: Vec) -> tuple[int, int, int, int]:
+        """The columns ``i0..i1 - 1`` and rows ``j0..j1 - 1`` of the grid the box
+        ``lo``..``hi`` (m) covers (none when it misses the grid)."""
         first = np.maximum(self.cell_of(lo[None, :])[0], 0)
         last = np.maximum(np.minimum(self.cell_of(hi[None, :])[0] + 1, self.shape), first)
-        return first, (slice(int(first[0]), int(last[0])), slice(int(first[1]), int(last[1])))
+        return int(first[0]), int(last[0]), int(first[1]), int(last[1])
 
     def has_returns_in(self, lo: Vec, hi: Vec) -> bool:
         """Whether a cell inside the box ``lo``..``hi`` (m) was occupied when last seen,
         within the decay time (a return, confirmed as lethal or not yet)."""
-        _, part = self._returns_in(lo, hi)
-        return bool((self.occupied[part] & (self.seen[part] >= self.now - self.decay)).any())
+        return self._returns_near(self._returns_in(lo, hi), (0.0, 0.0), (0.0, 0.0),
+                                  math.inf)
 
     def _kept_walls(self) -> BoolGrid:
         """The walls kept past the decay and through recovery's clearing: seen within
@@ -373,19 +374,19 @@ class Costmap:
         """Whether a cell occupied when last seen, within the decay time (a return,
         confirmed as lethal or not yet), has its centre within ``distance`` m of the
         segment from ``a`` to ``b``; with ``lo`` and ``hi`` (m), only the cells inside
-        that box count."""
+        that box count. One compiled pass over the box (``_loops.returns_near``)."""
         if lo is None or hi is None:
             lo, hi = np.minimum(a, b) - distance, np.maximum(a, b) + distance
-        first, part = self._returns_in(lo, hi)
-        cells = np.argwhere(self.occupied[part] & (self.seen[part] >= self.now - self.decay))
-        if len(cells) == 0:
-            return False
-        rel = self.centre_of(cells + first) - a
-        offset = b - a
-        length2 = float(offset @ offset)
-        t = np.clip(rel @ offset / length2, 0.0, 1.0) if length2 > 0 else np.zeros(len(rel))
-        gaps = np.hypot(*(rel - t[:, None] * offset[None, :]).T)
-        return bool((gaps <= distance).any())
+        return self._returns_near(self._returns_in(lo, hi), (float(a[0]), float(a[1])),
+                                  (float(b[0]), float(b[1])), distance)
+
+    def _returns_near(self, part: tuple[int, int, int, int], a: tuple[float, float],
+                      b: tuple[float, float], distance: float) -> bool:
+        i0, i1, j0, j1 = part
+        return returns_near(_flat(self.occupied).view(np.uint8), _flat(self.seen),
+                            self.shape[1], i0, i1, j0, j1, self.now - self.decay,
+                            float(self.origin[0]), float(self.origin[1]), self.resolution,
+                            a[0], a[1], b[0], b[1], distance)
 
     def lethal_near(self, centre: Vec, radius: float) -> Vec:
         """(n, 2) centres of the lethal cells within ``radius`` m of ``centre``."""
