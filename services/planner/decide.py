@@ -35,7 +35,7 @@ import numpy.typing as npt
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
 from zenav.services.geometry import disc_distance, wrap_angle
 from zenav.services.planner import safety
-from zenav.services.planner._loops import box_gaps
+from zenav.services.planner._loops import box_gaps, c_hypot
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import backing_toward, command_toward
@@ -264,7 +264,7 @@ class Planner:
         or the paper's straight line when ``around_obstacles`` is off."""
         p = self.p
         if not p.around_obstacles or len(lows) == 0:
-            return lambda end: float(np.hypot(*(self.goal - end)))
+            return lambda end: c_hypot(*(self.goal - end))
         reach = p.window_radius + 2.0
         field = distance_field(
             self.goal, lows, highs, np.minimum(robot, self.goal) - reach,
@@ -306,7 +306,7 @@ class Planner:
         for s in np.arange(min(s0 + p.window_radius, length), s0 - p.cell, -p.cell / 2):
             on_path = point_at(self.path, max(float(s), 0.0), self.lengths)
             leg = on_path - point
-            leg_length = float(np.hypot(*leg))
+            leg_length = c_hypot(*leg)
             if leg_length > p.window_radius:
                 continue
             if leg_length < 1e-9:
@@ -335,7 +335,7 @@ class Planner:
         planner already answers keep ``threat_hysteresis`` more margin, so that a threat
         does not flicker on and off with the estimates' noise."""
         offset = target - robot
-        distance = float(np.hypot(*offset))
+        distance = c_hypot(*offset)
         if distance < 1e-9:
             return []
         direction = offset / distance
@@ -366,7 +366,7 @@ class Planner:
         bends: the distance to the goal on the paper's straight path, to the next vertex
         on one that goes round what the map holds."""
         if self.path is None or self.lengths is None or len(self.path) <= 2:
-            return float(np.hypot(*(self.goal - robot)))
+            return c_hypot(*(self.goal - robot))
         return straight_ahead(self.path, robot, direction, self.lengths)
 
     def _chord_clear(self, robot: Vec, point: Vec) -> bool:
@@ -374,7 +374,7 @@ class Planner:
         if self.costmap is None:
             return True
         offset = point - robot
-        distance = float(np.hypot(*offset))
+        distance = c_hypot(*offset)
         if distance <= self.p.map_resolution:
             return True
         if self._blocked_along(robot, offset / distance, self.p.map_resolution, distance):
@@ -417,7 +417,7 @@ class Planner:
             return False
         lo, hi = cell_squares(a.obstacle.cells, self.p.cell)
         offset = target - robot
-        distance = float(np.hypot(*offset))
+        distance = c_hypot(*offset)
         if distance < 1e-9 or not self.costmap.has_returns_in(lo, hi):
             return False
         direction = offset / distance
@@ -459,7 +459,7 @@ class Planner:
         if self.costmap is None or not self.p.use_map:
             return False
         offset = target - robot
-        distance = float(np.hypot(*offset))
+        distance = c_hypot(*offset)
         if distance < 1e-9:
             return True
         direction = offset / distance
@@ -493,7 +493,7 @@ class Planner:
     def _leg(self, robot: Vec, end: Vec) -> Vec:
         """Points every half map cell on the straight way from ``robot`` to ``end``."""
         offset = end - robot
-        distance = float(np.hypot(*offset))
+        distance = c_hypot(*offset)
         return path_points(robot, offset / max(distance, 1e-9), distance,
                            self.p.map_resolution / 2)
 
@@ -560,7 +560,7 @@ class Planner:
         while the slower speed stays above the floor; a stop lasts until the obstacle has
         passed."""
         p = self.p
-        ob_speed = float(np.hypot(*a.obstacle.velocity))
+        ob_speed = c_hypot(*a.obstacle.velocity)
         if ob_speed < 1e-6:
             return "stop", 0.0
         clearance = p.robot_radius + a.obstacle.radius + p.safety_margin
@@ -633,7 +633,7 @@ class Planner:
         p = self.p
         if not p.speed_check or p.drive_on_growth <= 0.0:
             return False
-        if float(np.hypot(*(target - np.asarray(pose[:2], dtype=np.float64)))) <= 1e-9:
+        if c_hypot(*(target - np.asarray(pose[:2], dtype=np.float64))) <= 1e-9:
             return False
         robot, group, heading, blocked = self._safety_inputs(pose, target, walkers, ages)
         wary = dataclasses.replace(self.safety_settings,
@@ -661,7 +661,7 @@ class Planner:
         """Whether a crosser has got across the line the robot is driving along (it is
         on the far side of it, moving away, clear by the clearance)."""
         offset = target - robot
-        length = float(np.hypot(*offset))
+        length = c_hypot(*offset)
         if length < 1e-9:
             return True
         d = offset / length
@@ -722,8 +722,8 @@ class Planner:
         # Past a walker standing by the goal, the paper's length (to S_k's far side and a
         # clearance more) puts the sub-target beyond the goal, and the robot drives by
         # the goal to reach it.
-        to_the_goal = float(np.hypot(*(self.goal - robot)))
-        ahead = float(np.hypot(*(centre - robot)))
+        to_the_goal = c_hypot(*(self.goal - robot))
+        ahead = c_hypot(*(centre - robot))
         if ahead + extra > to_the_goal:
             ahead = min(ahead, max(to_the_goal, p.cell))
             centre = robot + axis * ahead
@@ -774,7 +774,7 @@ class Planner:
         path_target = self.path_target(robot, self._statics(in_window))
 
         if self.detour is not None:
-            reached = float(np.hypot(*(self.detour.subtarget - robot))) < p.subtarget_reached
+            reached = c_hypot(*(self.detour.subtarget - robot)) < p.subtarget_reached
             direct = self._assess_all(robot, path_target, in_window, p.resume_hysteresis,
                                       to_goal=True)
             if reached or not any(a.threat and a.letter in "bf" for a in direct):
@@ -896,7 +896,7 @@ class Planner:
                 and self.clear_at_cruise(pose, target, walkers, ages)):
             speed, action = p.cruise_speed, "keep"
         self.safety_heading = None if not (movers or unseen) else self.safety_heading
-        if p.speed_check and (movers or unseen) and float(np.hypot(*(target - robot))) > 1e-9:
+        if p.speed_check and (movers or unseen) and c_hypot(*(target - robot)) > 1e-9:
             choice = self.speed_and_safety(pose, target, speed, walkers, path_target, ages)
             if not choice.kept:
                 culprit = walkers[choice.mover] if choice.mover is not None else None
@@ -993,7 +993,7 @@ class Planner:
             self._set_path(np.vstack([self.start, self.goal]), "start")
         self._remember_trail(robot)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        if float(np.hypot(*(self.goal - robot))) <= self.arrival_radius():
+        if c_hypot(*(self.goal - robot)) <= self.arrival_radius():
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
         if self.recovery.unreachable:
@@ -1180,7 +1180,7 @@ class Planner:
             return False
         mover = movers[0]
         velocity = np.asarray(mover.velocity, dtype=np.float64)
-        speed = float(np.hypot(*velocity))
+        speed = c_hypot(*velocity)
         overtaking = self._overtaking(robot, target, mover)
         if not overtaking:
             threat = next((a for a in threats if a.obstacle.id == mover.id), None)
@@ -1220,9 +1220,9 @@ class Planner:
         of it within ``horizon`` s even with the robot at its top speed."""
         p = self.p
         velocity = np.asarray(mover.velocity, dtype=np.float64)
-        speed = float(np.hypot(*velocity))
+        speed = c_hypot(*velocity)
         ahead = target - robot
-        length = float(np.hypot(*ahead))
+        length = c_hypot(*ahead)
         if speed <= p.max_speed or length < 1e-9:
             return False
         way = velocity / speed
@@ -1457,7 +1457,7 @@ class Planner:
     def to_go(self, robot: Vec) -> float:
         """Distance still to go along the global path (plus the way back onto it), m."""
         if self.path is None or self.lengths is None:
-            return float(np.hypot(*(self.goal - robot)))
+            return c_hypot(*(self.goal - robot))
         s0, off = project(self.path, robot, self.lengths)
         return float(self.lengths[-1]) - s0 + off
 
@@ -1501,7 +1501,7 @@ class Planner:
         instead. One line's cells (about 16 us) cost far less than a search, and are
         looked at each cycle from the first one a re-plan is due."""
         assert self.costmap is not None and self.path is not None and self.lengths is not None
-        straight = float(np.hypot(*(self.goal - robot)))
+        straight = c_hypot(*(self.goal - robot))
         if float(self.lengths[-1]) - s0 - straight <= self.p.path_deviation:
             return False
         line = np.vstack([robot, self.goal])
@@ -1523,7 +1523,7 @@ class Planner:
         run's own goal; beside it (``settle_goal``), what keeps the stop within the
         goal's tolerance, with a hundredth of it to spare."""
         p = self.p
-        off = float(np.hypot(*(self.goal - self.mission_goal)))
+        off = c_hypot(*(self.goal - self.mission_goal))
         if off < 1e-9:
             return p.arrival_distance()
         return min(p.arrival_distance(), p.goal_tolerance * 0.99 - off)
@@ -1538,7 +1538,7 @@ class Planner:
         p = self.p
         if self.costmap is None or not p.use_map:
             return
-        if float(np.hypot(*(self.mission_goal - robot))) > p.window_radius:
+        if c_hypot(*(self.mission_goal - robot)) > p.window_radius:
             return
         margin = p.robot_radius + p.safety_margin / 2
         if goal_clear(self.costmap, self.mission_goal, margin):
@@ -1549,7 +1549,7 @@ class Planner:
             if np.array_equal(aim, self.mission_goal):  # none clear with the margin
                 aim = settle_point(self.costmap, self.mission_goal, robot, p.robot_radius,
                                    SETTLE_REACH_CLOSE * p.goal_tolerance)
-        if float(np.hypot(*(aim - self.goal))) < 1e-9:
+        if c_hypot(*(aim - self.goal)) < 1e-9:
             return
         self.goal = aim
         if self.path is not None and len(self.path) >= 2:
