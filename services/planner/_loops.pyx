@@ -21,7 +21,7 @@ meaning; ``_loops.pyi`` gives their types.
 import numpy as np
 
 cimport cython
-from libc.math cimport INFINITY, cos, fma, hypot, sin, sqrt
+from libc.math cimport INFINITY, cos, fma, hypot, isnan, sin, sqrt
 from libc.string cimport memcmp, memset
 
 include "../_angles.pxi"
@@ -254,6 +254,55 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
             out[i] = grid[ix * ny + iy]
         else:
             out[i] = outside
+
+
+@cython.cdivision(True)
+def first_flagged_on(const double[:, ::1] points, const double[::1] lengths,
+                     const double[::1] s, double ox, double oy, double resolution,
+                     const unsigned char[::1] grid, Py_ssize_t ny, unsigned char outside):
+    """The index of the first arc length of ``s`` (non-decreasing) whose point on the
+    path (``points``, their non-decreasing arc ``lengths``) falls in a flagged cell of
+    the flat grid (``look_up``'s cells; ``outside`` beyond it), -1 when none does. The
+    point is ``np.interp(s, lengths, points[:, k])`` for each k, with numpy's
+    arithmetic: the ends' values outside the lengths, a vertex's own value at its
+    length, else slope (s - length_j) + value_j on segment j (from its far end if
+    that gives nan, and the near end's value if both do and the ends are equal)."""
+    cdef Py_ssize_t n = lengths.shape[0], nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, j = 0, k, ix, iy
+    cdef double x, slope
+    cdef double at[2]
+    cdef unsigned char flag
+    for i in range(s.shape[0]):
+        x = s[i]
+        for k in range(2):
+            if isnan(x):
+                at[k] = x
+            elif x < lengths[0]:
+                at[k] = points[0, k]
+            elif x >= lengths[n - 1]:
+                at[k] = points[n - 1, k]
+            else:
+                while lengths[j + 1] <= x:  # (x below the last length: j + 1 < n)
+                    j += 1
+                if lengths[j] == x:
+                    at[k] = points[j, k]
+                else:
+                    slope = ((points[j + 1, k] - points[j, k])
+                             / (lengths[j + 1] - lengths[j]))
+                    at[k] = slope * (x - lengths[j]) + points[j, k]
+                    if isnan(at[k]):
+                        at[k] = slope * (x - lengths[j + 1]) + points[j + 1, k]
+                        if isnan(at[k]) and points[j, k] == points[j + 1, k]:
+                            at[k] = points[j, k]
+        ix = cell_index(at[0] - ox, resolution)
+        iy = cell_index(at[1] - oy, resolution)
+        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+            flag = grid[ix * ny + iy]
+        else:
+            flag = outside
+        if flag:
+            return i
+    return -1
 
 
 def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, double oy,

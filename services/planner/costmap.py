@@ -55,6 +55,7 @@ from scipy.ndimage import distance_transform_edt
 from zenav.services.planner._loops import (
     beam_directions,
     closed_off,
+    first_flagged_on,
     lethal_cells,
     line_any,
     look_up,
@@ -496,6 +497,17 @@ class Costmap:
                 length, count = step * (last - first), last - first + 1
         return line_any(x, y, dx, dy, length, count, ox, oy, self.resolution,
                         _flat(grid).view(np.uint8), self.shape[1], False)
+
+    def first_blocked_on(self, points: Vec, lengths: Vec, s: Vec) -> int:
+        """The index of the first arc length of ``s`` (non-decreasing) whose point on the
+        path (``points``, arc ``lengths``; ``np.interp``'s points) lies in a blocked cell
+        or beyond the grid, -1 when none does; in compiled code (``_loops.first_flagged_on``,
+        stopping at the first)."""
+        return first_flagged_on(np.ascontiguousarray(points, dtype=np.float64),
+                                np.ascontiguousarray(lengths, dtype=np.float64),
+                                np.ascontiguousarray(s, dtype=np.float64),
+                                float(self.origin[0]), float(self.origin[1]), self.resolution,
+                                _flat(self.blocked()).view(np.uint8), self.shape[1], True)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
         return self._look_up(points, self._refresh()[0], False)

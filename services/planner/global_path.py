@@ -317,7 +317,5 @@ def first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float,
     if from_s >= total:
         return None
     s = np.arange(from_s, total + step / 2, step)
-    samples = np.column_stack([np.interp(s, lengths, points[:, 0]),
-                               np.interp(s, lengths, points[:, 1])])
-    hit = costmap.blocked_at(samples, outside=True)
-    return float(s[int(np.argmax(hit))]) if hit.any() else None
+    first = costmap.first_blocked_on(points, lengths, s)
+    return float(s[first]) if first >= 0 else None

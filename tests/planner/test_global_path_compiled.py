@@ -154,3 +154,51 @@ def test_straight_ahead_is_the_numpy_loop(seed: int) -> None:
         assert got == want
         seen.add(want == 0.0)
     assert seen == {True, False}
+
+
+def numpy_first_blocked(costmap: Costmap, points: Vec, from_s: float, step: float
+                        ) -> float | None:
+    """``first_blocked`` as numpy operations (the code the compiled walk replaced)."""
+    lengths = global_path.arc_lengths(points)
+    total = float(lengths[-1])
+    if from_s >= total:
+        return None
+    s = np.arange(from_s, total + step / 2, step)
+    samples = np.column_stack([np.interp(s, lengths, points[:, 0]),
+                               np.interp(s, lengths, points[:, 1])])
+    hit = costmap.blocked_at(samples, outside=True)
+    return float(s[int(np.argmax(hit))]) if hit.any() else None
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_first_blocked_is_the_numpy_sampling(seed: int) -> None:
+    """Random paths (some with a repeated vertex, some leaving the grid) on random maps,
+    from random arc lengths (some before the start): the same arc length, or None."""
+    rng = np.random.default_rng(700 + seed)
+    costmap = Costmap((0.0, 0.0), (6.0, 3.0), resolution=0.1, decay=60.0, inflation=0.3,
+                      padding=2.0, max_size=40.0)
+    nx, ny = costmap.shape
+    costmap.now = 10.0
+    seen = {"blocked": 0, "beyond": 0, "none": 0}
+    for _ in range(200):
+        costmap.occupied[:] = rng.random((nx, ny)) < float(rng.choice([0.0, 0.002, 0.01]))
+        costmap.seen[:] = 10.0
+        costmap.hit_since[:] = 0.0
+        costmap.version += 1
+        points = rng.uniform(costmap.origin - 1.0,
+                             costmap.origin + np.array([nx, ny]) * 0.1 + 1.0,
+                             (int(rng.integers(2, 7)), 2))
+        if rng.random() < 0.3:  # a repeated vertex: a segment of length 0
+            k = int(rng.integers(0, len(points)))
+            points = np.insert(points, k, points[k], axis=0)
+        from_s = float(rng.uniform(-1.0, 4.0))
+        step = float(rng.choice([0.05, 0.1, 0.13]))
+        want = numpy_first_blocked(costmap, points, from_s, step)
+        assert global_path.first_blocked(costmap, points, from_s, step) == want
+        if want is None:
+            seen["none"] += 1
+        else:
+            at = np.array([[np.interp(want, global_path.arc_lengths(points), points[:, k])
+                            for k in range(2)]])
+            seen["beyond" if not costmap.inside(costmap.cell_of(at))[0] else "blocked"] += 1
+    assert all(seen.values())  # blocked cells, the grid's edge, and clear paths all occur
