@@ -305,6 +305,33 @@ def first_flagged_on(const double[:, ::1] points, const double[::1] lengths,
     return -1
 
 
+def squares_clear(const unsigned char[::1] grid, Py_ssize_t ny, double ox, double oy,
+                  double resolution, double px, double py, double span, double clearance):
+    """Whether every flagged cell of the flat grid (``ny`` cells a column) whose square
+    meets the box (px, py) +- ``span`` lies at least ``clearance`` from (px, py): the
+    box's cells by ``Costmap.cell_of``'s arithmetic, each square's lower corner
+    (ox + i resolution, oy + j resolution), the gap along each axis
+    max(max(corner - p, 0), p - (corner + resolution)), their ``hypot``."""
+    cdef Py_ssize_t nx = grid.shape[0] // ny
+    cdef Py_ssize_t i, j
+    cdef Py_ssize_t i0 = max(cell_index(px - span - ox, resolution), 0)
+    cdef Py_ssize_t j0 = max(cell_index(py - span - oy, resolution), 0)
+    cdef Py_ssize_t i1 = min(cell_index(px + span - ox, resolution) + 1, nx)
+    cdef Py_ssize_t j1 = min(cell_index(py + span - oy, resolution) + 1, ny)
+    cdef double cx, cy, gx, gy
+    for i in range(i0, i1):
+        for j in range(j0, j1):
+            if not grid[i * ny + j]:
+                continue
+            cx = ox + <double>i * resolution
+            cy = oy + <double>j * resolution
+            gx = max(max(cx - px, 0.0), px - (cx + resolution))
+            gy = max(max(cy - py, 0.0), py - (cy + resolution))
+            if not hypot(gx, gy) >= clearance:
+                return False
+    return True
+
+
 def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, double oy,
                  double resolution, const unsigned char[::1] grid, Py_ssize_t ny,
                  unsigned char[::1] out):

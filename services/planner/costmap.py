@@ -62,6 +62,7 @@ from zenav.services.planner._loops import (
     look_up_rows,
     return_bounds,
     returns_near,
+    squares_clear,
     stamp_discs,
     trace_scan,
 )
@@ -508,6 +509,15 @@ class Costmap:
                                 np.ascontiguousarray(s, dtype=np.float64),
                                 float(self.origin[0]), float(self.origin[1]), self.resolution,
                                 _flat(self.blocked()).view(np.uint8), self.shape[1], True)
+
+    def squares_clear(self, point: tuple[float, float], span: float, clearance: float) -> bool:
+        """Whether every lethal cell whose square meets the box ``point`` +- ``span`` (m)
+        lies at least ``clearance`` m from the point, its distance taken to the cell's
+        square; in compiled code (``_loops.squares_clear``), stopping at the first that
+        does not."""
+        return squares_clear(_flat(self.lethal_grid()).view(np.uint8), self.shape[1],
+                             float(self.origin[0]), float(self.origin[1]), self.resolution,
+                             point[0], point[1], span, clearance)
 
     def lethal_at(self, points: Vec) -> npt.NDArray[np.bool_]:
         return self._look_up(points, self._refresh()[0], False)

@@ -229,10 +229,8 @@ def _clear_of(low: Vec, side: float, points: Vec, clearance: float) -> npt.NDArr
 def goal_clear(costmap: Costmap, goal: Vec, clearance: float) -> bool:
     """Whether every occupied cell's square lies at least ``clearance`` from ``goal``:
     ``settle_point``'s answer is then the goal itself, whatever its reach."""
-    goal = np.asarray(goal, dtype=np.float64)
-    low = _squares_near(costmap, goal, clearance + costmap.resolution)
-    return len(low) == 0 or bool(_clear_of(low, costmap.resolution, goal[None, :],
-                                           clearance)[0])
+    return costmap.squares_clear((float(goal[0]), float(goal[1])),
+                                 clearance + costmap.resolution, clearance)
 
 
 def settle_point(costmap: Costmap, goal: Vec, toward: Vec, clearance: float,
@@ -251,9 +249,9 @@ def settle_point(costmap: Costmap, goal: Vec, toward: Vec, clearance: float,
     grid holds nothing known."""
     goal = np.asarray(goal, dtype=np.float64)
     r = costmap.resolution
-    low = _squares_near(costmap, goal, reach + clearance + r)
-    if len(low) == 0 or _clear_of(low, r, goal[None, :], clearance)[0]:
+    if goal_clear(costmap, goal, clearance):
         return goal
+    low = _squares_near(costmap, goal, reach + clearance + r)
     angles = np.linspace(0.0, 2.0 * math.pi, SETTLE_BEARINGS, endpoint=False)
     ring = np.column_stack([np.cos(angles), np.sin(angles)])
     step = r / 2
