@@ -25,8 +25,6 @@ def window_points(ranges: npt.NDArray[np.float64], angle_min: float, angle_incre
                   beams: npt.NDArray[np.int64], rho: npt.NDArray[np.float64],
                   alpha: npt.NDArray[np.float64], px: npt.NDArray[np.float64],
                   py: npt.NDArray[np.float64], xy: npt.NDArray[np.float64]) -> int: ...
-def eq1_rows(x: float, y: float, heading: float, rho: npt.NDArray[np.float64],
-             alpha: npt.NDArray[np.float64], out: npt.NDArray[np.float64]) -> None: ...
 def run_bounds(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
                rho: npt.NDArray[np.float64], join_scale: float, join_step: float,
                join_floor: float, starts: npt.NDArray[np.int64],

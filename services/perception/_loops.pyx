@@ -179,17 +179,6 @@ def window_points(const double[::1] ranges, double angle_min, double angle_incre
     return k
 
 
-def eq1_rows(double x, double y, double heading, const double[::1] rho,
-             const double[::1] alpha, double[:, ::1] out):
-    """Eq. 1 for each (rho, alpha) from the robot at (x, y, heading), into the rows of
-    ``out``: (x + rho cos(heading + alpha), y + rho sin(heading + alpha)), as
-    ``clustering.to_global`` computes them."""
-    cdef Py_ssize_t i
-    for i in range(rho.shape[0]):
-        out[i, 0] = x + rho[i] * cos(heading + alpha[i])
-        out[i, 1] = y + rho[i] * sin(heading + alpha[i])
-
-
 def run_bounds(const double[::1] px, const double[::1] py, const double[::1] rho,
                double join_scale, double join_step, double join_floor,
                long[::1] starts, long[::1] ends, long[::1] counts):

@@ -393,8 +393,7 @@ def cluster_window(
 
     # Eq. 5: mean alpha and mean rho, then Eq. 1 for the global centre.
     mean_rho, mean_alpha = cluster_means(rho, alpha, starts, counts)
-    centre = np.empty((k, 2))
-    _loops.eq1_rows(x_r, y_r, th_r, mean_rho, mean_alpha, centre)  # to_global's arithmetic
+    centre = np.column_stack(to_global(pose, mean_rho, mean_alpha))
 
     # Eq. 2 on every point, Eq. 6 box over all of them (S_k's edges, see the module notes).
     # The metric bounding box is shrunk by ``edge_inset`` on each side (never past its

@@ -1,6 +1,6 @@
 """The clustering's compiled passes (``_loops.window_points``, ``run_bounds``,
-``eq1_rows``, ``run_shapes`` and ``edge_codes``, what ``cluster_scan`` calls) give, to
-the bit, the obstacle chain of the numpy code they replaced, field by field."""
+``run_shapes`` and ``edge_codes``, what ``cluster_scan`` calls) give, to the bit, the
+obstacle chain of the numpy code they replaced, field by field."""
 
 from __future__ import annotations
 
@@ -184,7 +184,7 @@ def test_every_edge_code_and_the_speck_filter_occur() -> None:
 
 def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
-    for name in ("window_points", "run_bounds", "eq1_rows", "run_shapes", "edge_codes"):
+    for name in ("window_points", "run_bounds", "run_shapes", "edge_codes"):
         real = getattr(_loops, name)
 
         def counted(*args: object, _real: object = real, _name: str = name) -> object:
@@ -194,8 +194,7 @@ def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -
         monkeypatch.setattr(_loops, name, counted)
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
-    assert sorted(calls) == ["edge_codes", "eq1_rows", "run_bounds", "run_shapes",
-                            "window_points"]
+    assert sorted(calls) == ["edge_codes", "run_bounds", "run_shapes", "window_points"]
 
 
 @pytest.mark.parametrize("seed", range(5))
