@@ -24,7 +24,7 @@ def window_points(ranges: npt.NDArray[np.float64], angle_min: float, angle_incre
                   y: float, heading: float, valid: npt.NDArray[np.uint8],
                   beams: npt.NDArray[np.int64], rho: npt.NDArray[np.float64],
                   alpha: npt.NDArray[np.float64], px: npt.NDArray[np.float64],
-                  py: npt.NDArray[np.float64], xy: npt.NDArray[np.float64]) -> int: ...
+                  py: npt.NDArray[np.float64]) -> int: ...
 def run_bounds(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
                rho: npt.NDArray[np.float64], join_scale: float, join_step: float,
                join_floor: float, starts: npt.NDArray[np.int64],

@@ -151,14 +151,13 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
 def window_points(const double[::1] ranges, double angle_min, double angle_increment,
                   double range_min, double range_max, double window_radius, double x,
                   double y, double heading, unsigned char[::1] valid, long[::1] beams,
-                  double[::1] rho, double[::1] alpha, double[::1] px, double[::1] py,
-                  double[:, ::1] xy):
+                  double[::1] rho, double[::1] alpha, double[::1] px, double[::1] py):
     """``clustering.scan_window`` in one pass: into ``valid`` whether each beam has a
     return (``range_min <= r < range_max``; nan has none), and, filled from the front,
     the beams with a return within ``window_radius``, their ranges, their angles
     (angle_min + i angle_increment) and their global points by Eq. 1 from the robot at
-    (x, y, heading): (x + rho cos(heading + alpha), y + rho sin(heading + alpha)), in
-    ``px`` and ``py`` and again as the rows of ``xy``. Returns how many there are."""
+    (x, y, heading): (x + rho cos(heading + alpha), y + rho sin(heading + alpha)).
+    Returns how many there are."""
     cdef Py_ssize_t i, k = 0
     cdef double r, a
     cdef bint has
@@ -173,8 +172,6 @@ def window_points(const double[::1] ranges, double angle_min, double angle_incre
             alpha[k] = a
             px[k] = x + r * cos(heading + a)
             py[k] = y + r * sin(heading + a)
-            xy[k, 0] = px[k]
-            xy[k, 1] = py[k]
             k += 1
     return k
 

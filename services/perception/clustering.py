@@ -242,7 +242,6 @@ class Window:
         alpha: (k,) their angles relative to the heading, radians.
         x: (k,) their global points (Eq. 1), metres.
         y: (k,)
-        points: (k, 2) the same points as rows (x, y).
     """
 
     ranges: FloatArray
@@ -252,7 +251,6 @@ class Window:
     alpha: FloatArray
     x: FloatArray
     y: FloatArray
-    points: FloatArray
 
 
 def scan_window(
@@ -271,14 +269,13 @@ def scan_window(
     valid = np.empty(n, dtype=np.bool_)
     idx = np.empty(n, dtype=np.int64)
     rho, alpha, px, py = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    xy = np.empty((n, 2))
     # One compiled pass (NaN compares False everywhere, so it drops out as "no return"
     # like inf does); the points by Eq. 1 with to_global's operations.
     x, y, heading = pose
     k = _loops.window_points(r, angle_min, angle_increment, range_min, range_max,
                              window_radius, x, y, heading, valid.view(np.uint8), idx, rho,
-                             alpha, px, py, xy)
-    return Window(r, valid, idx[:k], rho[:k], alpha[:k], px[:k], py[:k], xy[:k])
+                             alpha, px, py)
+    return Window(r, valid, idx[:k], rho[:k], alpha[:k], px[:k], py[:k])
 
 
 def full_circle(n_beams: int, angle_increment: float) -> int:
