@@ -19,21 +19,14 @@ def free_scores(points: npt.NDArray[np.float64], member: npt.NDArray[np.int64],
                 ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
                 lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], margin: float,
                 scores: npt.NDArray[np.float64]) -> None: ...
-def window_points(ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
-                  range_min: float, range_max: float, window_radius: float, x: float,
-                  y: float, heading: float, valid: npt.NDArray[np.uint8],
-                  beams: npt.NDArray[np.int64], rho: npt.NDArray[np.float64],
-                  alpha: npt.NDArray[np.float64], px: npt.NDArray[np.float64],
-                  py: npt.NDArray[np.float64]) -> int: ...
 def run_bounds(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
-               rho: npt.NDArray[np.float64], join_scale: float, join_step: float,
-               join_floor: float, starts: npt.NDArray[np.int64],
+               threshold: npt.NDArray[np.float64], starts: npt.NDArray[np.int64],
                ends: npt.NDArray[np.int64], counts: npt.NDArray[np.int64]) -> int: ...
 def run_shapes(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
                starts: npt.NDArray[np.int64], ends: npt.NDArray[np.int64], inset: float,
-               cell: float, box: npt.NDArray[np.int64], area: npt.NDArray[np.int64],
-               first_point: npt.NDArray[np.float64], last_point: npt.NDArray[np.float64],
-               chord: npt.NDArray[np.float64], radius: npt.NDArray[np.float64]) -> None: ...
+               edges: npt.NDArray[np.float64], first_point: npt.NDArray[np.float64],
+               last_point: npt.NDArray[np.float64], chord: npt.NDArray[np.float64],
+               radius: npt.NDArray[np.float64]) -> None: ...
 def edge_codes(ranges: npt.NDArray[np.float64], valid: npt.NDArray[np.uint8],
                beams: npt.NDArray[np.int64], join_scale: float, join_step: float,
                join_floor: float, cos2: float, window_radius: float,

@@ -10,7 +10,7 @@ meaning and the equations (Eq. 3's threshold comes in as an array from
 
 import numpy as np
 
-from libc.math cimport INFINITY, atan2, cos, fabs, floor, hypot, rint, sin, sqrt
+from libc.math cimport INFINITY, atan2, fabs, hypot, rint, sqrt
 from libc.stdlib cimport calloc, free
 
 include "../_angles.pxi"
@@ -148,43 +148,13 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
         free(entered)
 
 
-def window_points(const double[::1] ranges, double angle_min, double angle_increment,
-                  double range_min, double range_max, double window_radius, double x,
-                  double y, double heading, unsigned char[::1] valid, long[::1] beams,
-                  double[::1] rho, double[::1] alpha, double[::1] px, double[::1] py):
-    """``clustering.scan_window`` in one pass: into ``valid`` whether each beam has a
-    return (``range_min <= r < range_max``; nan has none), and, filled from the front,
-    the beams with a return within ``window_radius``, their ranges, their angles
-    (angle_min + i angle_increment) and their global points by Eq. 1 from the robot at
-    (x, y, heading): (x + rho cos(heading + alpha), y + rho sin(heading + alpha)).
-    Returns how many there are."""
-    cdef Py_ssize_t i, k = 0
-    cdef double r, a
-    cdef bint has
-    for i in range(ranges.shape[0]):
-        r = ranges[i]
-        has = r >= range_min and r < range_max
-        valid[i] = has
-        if has and r <= window_radius:
-            a = angle_min + <double>i * angle_increment
-            beams[k] = i
-            rho[k] = r
-            alpha[k] = a
-            px[k] = x + r * cos(heading + a)
-            py[k] = y + r * sin(heading + a)
-            k += 1
-    return k
-
-
-def run_bounds(const double[::1] px, const double[::1] py, const double[::1] rho,
-               double join_scale, double join_step, double join_floor,
+def run_bounds(const double[::1] px, const double[::1] py, const double[::1] threshold,
                long[::1] starts, long[::1] ends, long[::1] counts):
     """Cut the chain of points ``(px, py)`` where two consecutive points lie farther
-    apart than Eq. 3's join threshold of the later point (compared squared), the
-    threshold of a range rho as ``clustering.join_threshold`` computes it:
-    (join_scale rho) join_step + join_floor. Into ``starts``, ``ends`` and ``counts``
-    (filled from the front) the first and last point and the number of points of each
-    run. Returns the number of runs."""
+    apart than ``threshold`` (of the later point; ``threshold[i - 1]`` for points
+    ``i - 1`` and ``i``, compared squared): the first and last point and the number of
+    points of each run (``starts``, ``ends``, ``counts``, filled from the front).
+    Returns the number of runs."""
     cdef Py_ssize_t m = px.shape[0]
     cdef Py_ssize_t i
     cdef Py_ssize_t k = 1
@@ -193,7 +163,7 @@ def run_bounds(const double[::1] px, const double[::1] py, const double[::1] rho
     for i in range(1, m):
         dx = px[i] - px[i - 1]
         dy = py[i] - py[i - 1]
-        t = join_scale * rho[i] * join_step + join_floor
+        t = threshold[i - 1]
         if dx * dx + dy * dy > t * t:
             ends[k - 1] = i - 1
             starts[k] = i
@@ -205,15 +175,13 @@ def run_bounds(const double[::1] px, const double[::1] py, const double[::1] rho
 
 
 def run_shapes(const double[::1] px, const double[::1] py, const long[::1] starts,
-               const long[::1] ends, double inset, double cell, long[:, ::1] box,
-               long[::1] area, double[:, ::1] first_point, double[:, ::1] last_point,
-               double[:, ::1] chord, double[::1] radius):
-    """For each run of points ``starts[c]..ends[c]``: the grid box of its bounding box
-    shrunk by ``inset`` on each side, never past its middle (``box``: ix_min, ix_max,
-    iy_min, iy_max, each edge's Eq. 2 index floor(edge / cell + 1/2) as
-    ``clustering.grid_index`` gives it) and its Eq. 6 ``area`` in cells, its first and
-    last point, their midpoint (``chord``) and the largest distance from that midpoint
-    to a point of the run (``radius``)."""
+               const long[::1] ends, double inset, double[:, ::1] edges,
+               double[:, ::1] first_point, double[:, ::1] last_point, double[:, ::1] chord,
+               double[::1] radius):
+    """For each run of points ``starts[c]..ends[c]``: its bounding box shrunk by
+    ``inset`` on each side, never past its middle (``edges``: x_min, x_max, y_min,
+    y_max), its first and last point, their midpoint (``chord``) and the largest
+    distance from that midpoint to a point of the run (``radius``)."""
     cdef Py_ssize_t c, i
     cdef double lo_x, hi_x, lo_y, hi_y, in_x, in_y, cx, cy, ex, ey, d2, far
     for c in range(starts.shape[0]):
@@ -226,11 +194,10 @@ def run_shapes(const double[::1] px, const double[::1] py, const long[::1] start
             hi_y = max(hi_y, py[i])
         in_x = min(inset, (hi_x - lo_x) / 2)
         in_y = min(inset, (hi_y - lo_y) / 2)
-        box[c, 0] = <long>floor((lo_x + in_x) / cell + 0.5)
-        box[c, 1] = <long>floor((hi_x - in_x) / cell + 0.5)
-        box[c, 2] = <long>floor((lo_y + in_y) / cell + 0.5)
-        box[c, 3] = <long>floor((hi_y - in_y) / cell + 0.5)
-        area[c] = (box[c, 1] - box[c, 0] + 1) * (box[c, 3] - box[c, 2] + 1)
+        edges[c, 0] = lo_x + in_x
+        edges[c, 1] = hi_x - in_x
+        edges[c, 2] = lo_y + in_y
+        edges[c, 3] = hi_y - in_y
         first_point[c, 0] = px[starts[c]]
         first_point[c, 1] = py[starts[c]]
         last_point[c, 0] = px[ends[c]]

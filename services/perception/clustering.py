@@ -265,17 +265,13 @@ def scan_window(
     """The returns of a scan inside the window (rho <= ``window_radius``), made global with
     Eq. 1 (arguments as :func:`cluster_scan`'s)."""
     r = np.ascontiguousarray(ranges, dtype=np.float64)
-    n = r.shape[0]
-    valid = np.empty(n, dtype=np.bool_)
-    idx = np.empty(n, dtype=np.int64)
-    rho, alpha, px, py = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    # One compiled pass (NaN compares False everywhere, so it drops out as "no return"
-    # like inf does); the points by Eq. 1 with to_global's operations.
-    x, y, heading = pose
-    k = _loops.window_points(r, angle_min, angle_increment, range_min, range_max,
-                             window_radius, x, y, heading, valid.view(np.uint8), idx, rho,
-                             alpha, px, py)
-    return Window(r, valid, idx[:k], rho[:k], alpha[:k], px[:k], py[:k])
+    # NaN compares False everywhere, so it drops out as "no return" like inf does.
+    valid = (r >= range_min) & (r < range_max)
+    idx = np.flatnonzero(valid & (r <= window_radius))
+    rho = r[idx]
+    alpha = (angle_min + idx * angle_increment).astype(np.float64, copy=False)
+    px, py = to_global(pose, rho, alpha)  # Eq. 1
+    return Window(r, valid, idx, rho, alpha, px, py)
 
 
 def full_circle(n_beams: int, angle_increment: float) -> int:
@@ -364,14 +360,11 @@ def cluster_window(
     rho, alpha, px, py = window.rho, window.alpha, window.x, window.y
 
     # Eq. 3: a new cluster starts where the distance to the previous point exceeds theta
-    # (compared squared, both sides are non-negative; compiled, one pass, the threshold
-    # of each point as join_threshold computes it).
+    # (compared squared, both sides are non-negative; compiled, one pass).
+    thr = join_threshold(rho[1:], angle_increment, params)
     m = idx.size
-    starts = np.empty(m, dtype=np.int64)
-    ends = np.empty(m, dtype=np.int64)
-    counts = np.empty(m, dtype=np.int64)
-    k = _loops.run_bounds(px, py, rho, params.lambda_, math.sin(abs(angle_increment)),
-                          params.gap_floor, starts, ends, counts)
+    starts, ends, counts = (np.empty(m, dtype=np.int64) for _ in range(3))
+    k = _loops.run_bounds(px, py, thr, starts, ends, counts)
     starts, ends, counts = starts[:k], ends[:k], counts[:k]
 
     if params.min_beams > 1:
@@ -398,15 +391,15 @@ def cluster_window(
     # of boxes laid out on the grid do, then stays in the obstacle's cell instead of
     # spilling into the free one beside it, whichever way range noise moved the point.
     # The boxes, end points, chord centres and radii in one compiled pass over the runs.
-    # Eq. 2 (ix_min, ix_max, iy_min, iy_max, as grid_index) and Eq. 6 there too.
-    box = np.empty((k, 4), dtype=np.int64)
-    area = np.empty(k, dtype=np.int64)
+    edges = np.empty((k, 4))
     first_point = np.empty((k, 2))
     last_point = np.empty((k, 2))
     chord = np.empty((k, 2))
     radius = np.empty(k)
-    _loops.run_shapes(px, py, starts, ends, params.edge_inset, cell, box, area, first_point,
-                      last_point, chord, radius)
+    _loops.run_shapes(px, py, starts, ends, params.edge_inset, edges, first_point, last_point,
+                      chord, radius)
+    box = grid_index(edges, cell)  # Eq. 2: ix_min, ix_max, iy_min, iy_max
+    area = box_area(box)  # Eq. 6
 
     beams = np.empty((k, 2), dtype=np.int64)
     beams[:, 0] = idx[starts]
