@@ -27,7 +27,11 @@ def run_shapes(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
                edges: npt.NDArray[np.float64], first_point: npt.NDArray[np.float64],
                last_point: npt.NDArray[np.float64], chord: npt.NDArray[np.float64],
                radius: npt.NDArray[np.float64]) -> None: ...
-def edge_codes(ranges: npt.NDArray[np.float64], valid: npt.NDArray[np.uint8],
-               beams: npt.NDArray[np.int64], join_scale: float, join_step: float,
-               join_floor: float, cos2: float, window_radius: float,
-               codes: npt.NDArray[np.int64]) -> None: ...
+def edge_ranges(ranges: npt.NDArray[np.float64], valid: npt.NDArray[np.uint8],
+                beams: npt.NDArray[np.int64], rho_edge: npt.NDArray[np.float64],
+                rho_next: npt.NDArray[np.float64], rho_top: npt.NDArray[np.float64],
+                has: npt.NDArray[np.uint8], outside: npt.NDArray[np.uint8]) -> None: ...
+def edge_codes(rho_edge: npt.NDArray[np.float64], rho_next: npt.NDArray[np.float64],
+               has: npt.NDArray[np.uint8], outside: npt.NDArray[np.uint8],
+               join_top: npt.NDArray[np.float64], join_edge: npt.NDArray[np.float64],
+               cos2: float, window_radius: float, codes: npt.NDArray[np.int64]) -> None: ...

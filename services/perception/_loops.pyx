@@ -215,33 +215,47 @@ def run_shapes(const double[::1] px, const double[::1] py, const long[::1] start
         radius[c] = sqrt(far)
 
 
-def edge_codes(const double[::1] ranges, const unsigned char[::1] valid,
-               const long[:, ::1] beams, double join_scale, double join_step,
-               double join_floor, double cos2, double window_radius, long[:, ::1] codes):
-    """The code of what lies beside each end of each cluster (``beams``: first, last
-    beam), from the beam beside it (first - 1, last + 1): 2 (clipped) when that beam is
-    outside the scan, or has a return beyond ``window_radius`` within the join threshold
-    of the larger of the two ranges of the end point (the distance by the law of
-    cosines; ``cos2``: twice the cosine of the beam step); else 1 (occluded) when it has
-    a return nearer than the end by more than the join threshold of the end's range;
-    else 0. The join threshold of a range rho is Eq. 3's, as
-    ``clustering.join_threshold`` computes it: (join_scale rho) join_step + join_floor."""
+def edge_ranges(const double[::1] ranges, const unsigned char[::1] valid,
+                const long[:, ::1] beams, double[:, ::1] rho_edge,
+                double[:, ::1] rho_next, double[:, ::1] rho_top,
+                unsigned char[:, ::1] has, unsigned char[:, ::1] outside):
+    """For each end of each cluster (``beams``: first, last beam), the beam beside it
+    (first - 1, last + 1): whether it lies outside the scan (``outside``), whether it has
+    a return (``has``, ``valid`` there), the range at the end (``rho_edge``), the
+    neighbour's range (``rho_next``, 0 without a return) and the larger of the two
+    (``rho_top``)."""
     cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t c, j, b
-    cdef bint outside, has
-    cdef double re, rn, d2, t
     for c in range(beams.shape[0]):
         for j in range(2):
             b = beams[c, j] + (1 if j else -1)
-            outside = b < 0 or b >= n
-            has = (not outside) and valid[b]
-            re = ranges[beams[c, j]]
-            rn = ranges[b] if has else 0.0
+            outside[c, j] = b < 0 or b >= n
+            has[c, j] = (not outside[c, j]) and valid[b]
+            rho_edge[c, j] = ranges[beams[c, j]]
+            rho_next[c, j] = ranges[b] if has[c, j] else 0.0
+            rho_top[c, j] = max(rho_edge[c, j], rho_next[c, j])
+
+
+def edge_codes(const double[:, ::1] rho_edge, const double[:, ::1] rho_next,
+               const unsigned char[:, ::1] has, const unsigned char[:, ::1] outside,
+               const double[:, ::1] join_top, const double[:, ::1] join_edge,
+               double cos2, double window_radius, long[:, ::1] codes):
+    """The code of what lies beside each end (``edge_ranges`` gave the ranges):
+    2 (clipped) outside the scan, or for a return beyond ``window_radius`` within
+    ``join_top`` (the join threshold of the larger range) of the end point, the distance
+    by the law of cosines (``cos2``: twice the cosine of the beam step); else 1
+    (occluded) for a return nearer than the end by more than ``join_edge``; else 0."""
+    cdef Py_ssize_t c, j
+    cdef double re, rn, d2, t
+    for c in range(rho_edge.shape[0]):
+        for j in range(2):
+            re = rho_edge[c, j]
+            rn = rho_next[c, j]
             d2 = re * re + rn * rn - cos2 * re * rn
-            t = join_scale * max(re, rn) * join_step + join_floor
-            if outside or (has and rn > window_radius and d2 <= t * t):
+            t = join_top[c, j]
+            if outside[c, j] or (has[c, j] and rn > window_radius and d2 <= t * t):
                 codes[c, j] = 2
-            elif has and rn < re - (join_scale * re * join_step + join_floor):
+            elif has[c, j] and rn < re - join_edge[c, j]:
                 codes[c, j] = 1
             else:
                 codes[c, j] = 0

@@ -449,12 +449,17 @@ def _edge_codes(
     * a return nearer than the edge point by more than the join threshold -> EDGE_OCCLUDED;
     * anything else (background behind, or a surface that did not join) -> EDGE_FREE.
     """
-    codes = np.empty((beams.shape[0], 2), dtype=np.int64)
+    k = beams.shape[0]
+    rho_edge, rho_next, rho_top = np.empty((k, 2)), np.empty((k, 2)), np.empty((k, 2))
+    has, outside = np.empty((k, 2), dtype=np.uint8), np.empty((k, 2), dtype=np.uint8)
+    _loops.edge_ranges(r, valid.view(np.uint8), beams, rho_edge, rho_next, rho_top, has,
+                       outside)
+    codes = np.empty((k, 2), dtype=np.int64)
     # Eq. 3 of the larger range (would the neighbour have joined?) and of the end's own
-    # range (is the neighbour nearer by more than that?), with join_threshold's numbers;
-    # the distance between the two points by the law of cosines (the angle between them
-    # is known). One compiled pass.
-    _loops.edge_codes(r, valid.view(np.uint8), beams, params.lambda_,
-                      math.sin(abs(angle_increment)), params.gap_floor,
+    # range (is the neighbour nearer by more than that?); the distance between the two
+    # points by the law of cosines (the angle between them is known).
+    _loops.edge_codes(rho_edge, rho_next, has, outside,
+                      join_threshold(rho_top, angle_increment, params),
+                      join_threshold(rho_edge, angle_increment, params),
                       2.0 * math.cos(angle_increment), params.window_radius, codes)
     return codes

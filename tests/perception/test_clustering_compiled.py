@@ -1,5 +1,5 @@
-"""The clustering's compiled passes (``_loops.run_bounds``, ``run_shapes`` and
-``edge_codes``, what ``cluster_scan`` calls) give, to the bit, the
+"""The clustering's compiled passes (``_loops.run_bounds``, ``run_shapes``,
+``edge_ranges`` and ``edge_codes``, what ``cluster_scan`` calls) give, to the bit, the
 obstacle chain of the numpy code they replaced, field by field."""
 
 from __future__ import annotations
@@ -163,7 +163,7 @@ def test_every_edge_code_and_the_speck_filter_occur() -> None:
 
 def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
-    for name in ("run_bounds", "run_shapes", "edge_codes"):
+    for name in ("run_bounds", "run_shapes", "edge_ranges", "edge_codes"):
         real = getattr(_loops, name)
 
         def counted(*args: object, _real: object = real, _name: str = name) -> object:
@@ -173,7 +173,7 @@ def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -
         monkeypatch.setattr(_loops, name, counted)
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
-    assert sorted(calls) == ["edge_codes", "run_bounds", "run_shapes"]
+    assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes"]
 
 
 @pytest.mark.parametrize("seed", range(5))
