@@ -46,19 +46,6 @@ def floor_quotients(const double[::1] offsets, double resolution, long[::1] out)
         out[i] = cell_index(offsets[i], resolution)
 
 
-def beam_directions(double heading, const double[::1] alpha, double[::1] ux,
-                    double[::1] uy):
-    """Each beam's unit direction in the global frame: Eq. 1 at rho = 1 m from the
-    origin, (0 + 1 cos(heading + alpha), 0 + 1 sin(heading + alpha)), as
-    ``clustering.to_global((0, 0, heading), 1.0, alpha)`` computes it."""
-    cdef Py_ssize_t i
-    cdef double a
-    for i in range(alpha.shape[0]):
-        a = heading + alpha[i]
-        ux[i] = 0.0 + cos(a)
-        uy[i] = 0.0 + sin(a)
-
-
 def return_bounds(double x, double y, const double[::1] ux, const double[::1] uy,
                   const double[::1] ranges, double range_min, double range_max):
     """(x_lo, y_lo, x_hi, y_hi): the box of the robot at (x, y) and every return

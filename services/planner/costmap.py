@@ -52,8 +52,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.ndimage import distance_transform_edt
 
+from zenav.services.perception.clustering import to_global
 from zenav.services.planner._loops import (
-    beam_directions,
     closed_off,
     first_flagged_on,
     lethal_cells,
@@ -176,10 +176,9 @@ class Costmap:
         self._disc = _disc_offsets(resolution, inflation)
         self._clearance_discs: dict[float, tuple[npt.NDArray[np.int_], npt.NDArray[np.int_]]] = {}
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
-        # The laser's (angle_min, increment, count), its beam angles, and room for each
-        # beam's direction in the global frame (filled anew each scan).
-        self._beams: tuple[tuple[float, float, int], npt.NDArray[np.float64],
-                           npt.NDArray[np.float64], npt.NDArray[np.float64]] | None = None
+        # The beams' angles from the heading, and the (angle_min, angle_increment, count)
+        # they were made for.
+        self._beams: tuple[tuple[float, float, int], npt.NDArray[np.float64]] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -258,12 +257,12 @@ class Costmap:
         beams = (scan.angle_min, scan.angle_increment, ranges.size)
         if self._beams is None or self._beams[0] != beams:  # the same laser, scan after scan
             self._beams = (beams, np.asarray(scan.angle_min + scan.angle_increment
-                                             * np.arange(ranges.size), dtype=np.float64),
-                           np.empty(ranges.size), np.empty(ranges.size))
-        _, alpha, ux, uy = self._beams
+                                             * np.arange(ranges.size), dtype=np.float64))
+        alpha = self._beams[1]
         # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
         # robot); a return lies at the robot plus its range times that (Eq. 1 again).
-        beam_directions(float(heading), alpha, ux, uy)
+        ux, uy = to_global((0.0, 0.0, heading), 1.0, alpha)
+        ux, uy = np.ascontiguousarray(ux), np.ascontiguousarray(uy)
         box = return_bounds(x, y, ux, uy, ranges, scan.range_min, scan.range_max)
         self._grow_to_box(*box, self.padding / 2)
         nx, ny = self.shape

@@ -16,7 +16,7 @@ from scipy.ndimage import distance_transform_edt
 
 from tests.planner.beam_cells import beam_cells as cells_of_beams
 from zenav.services.perception.clustering import to_global
-from zenav.services.planner._loops import beam_directions, floor_quotients
+from zenav.services.planner._loops import floor_quotients
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.prediction import path_count, path_points
 
@@ -359,18 +359,6 @@ def test_the_compiled_lethal_cells_are_lethals(seed: int) -> None:
         else:
             renewed += 1
     assert kept and renewed
-
-
-def test_beam_directions_are_eq_1_at_one_metre() -> None:
-    """The beams' global directions the update traces along: ``to_global`` at rho = 1 m
-    from the origin, to the bit (headings of every sign, and -0.0)."""
-    rng = np.random.default_rng(21)
-    alpha = np.concatenate([[0.0, -0.0], rng.uniform(-math.pi, math.pi, 500)])
-    ux, uy = np.empty_like(alpha), np.empty_like(alpha)
-    for heading in [0.0, -0.0, *rng.uniform(-10.0, 10.0, 20).tolist()]:
-        beam_directions(heading, alpha, ux, uy)
-        want_x, want_y = to_global((0.0, 0.0, heading), 1.0, alpha)
-        assert ux.tobytes() == want_x.tobytes() and uy.tobytes() == want_y.tobytes()
 
 
 def numpy_returns_near(cm: Costmap, a: np.ndarray, b: np.ndarray, distance: float,
