@@ -19,6 +19,10 @@ def free_scores(points: npt.NDArray[np.float64], member: npt.NDArray[np.int64],
                 ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
                 lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], margin: float,
                 scores: npt.NDArray[np.float64]) -> None: ...
+def window_beams(ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
+                 range_min: float, range_max: float, window_radius: float,
+                 valid: npt.NDArray[np.uint8], beams: npt.NDArray[np.int64],
+                 rho: npt.NDArray[np.float64], alpha: npt.NDArray[np.float64]) -> int: ...
 def run_bounds(px: npt.NDArray[np.float64], py: npt.NDArray[np.float64],
                threshold: npt.NDArray[np.float64], starts: npt.NDArray[np.int64],
                ends: npt.NDArray[np.int64], counts: npt.NDArray[np.int64]) -> int: ...

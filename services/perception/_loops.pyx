@@ -148,6 +148,30 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
         free(entered)
 
 
+def window_beams(const double[::1] ranges, double angle_min, double angle_increment,
+                 double range_min, double range_max, double window_radius,
+                 unsigned char[::1] valid, long[::1] beams, double[::1] rho,
+                 double[::1] alpha):
+    """The masks and indices of ``clustering.scan_window`` in one pass: into ``valid``
+    whether each beam has a return (``range_min <= r < range_max``; nan has none), and,
+    filled from the front, the beams with a return within ``window_radius``, their
+    ranges and their angles (angle_min + i angle_increment, numpy's arithmetic).
+    Returns how many there are."""
+    cdef Py_ssize_t i, k = 0
+    cdef double r
+    cdef bint has
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        has = r >= range_min and r < range_max
+        valid[i] = has
+        if has and r <= window_radius:
+            beams[k] = i
+            rho[k] = r
+            alpha[k] = angle_min + <double>i * angle_increment
+            k += 1
+    return k
+
+
 def run_bounds(const double[::1] px, const double[::1] py, const double[::1] threshold,
                long[::1] starts, long[::1] ends, long[::1] counts):
     """Cut the chain of points ``(px, py)`` where two consecutive points lie farther

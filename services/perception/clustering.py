@@ -265,11 +265,15 @@ def scan_window(
     """The returns of a scan inside the window (rho <= ``window_radius``), made global with
     Eq. 1 (arguments as :func:`cluster_scan`'s)."""
     r = np.ascontiguousarray(ranges, dtype=np.float64)
-    # NaN compares False everywhere, so it drops out as "no return" like inf does.
-    valid = (r >= range_min) & (r < range_max)
-    idx = np.flatnonzero(valid & (r <= window_radius))
-    rho = r[idx]
-    alpha = (angle_min + idx * angle_increment).astype(np.float64, copy=False)
+    n = r.shape[0]
+    valid = np.empty(n, dtype=np.bool_)
+    idx = np.empty(n, dtype=np.int64)
+    rho, alpha = np.empty(n), np.empty(n)
+    # The masks, the window's beams, ranges and angles in one compiled pass (NaN
+    # compares False everywhere, so it drops out as "no return" like inf does).
+    k = _loops.window_beams(r, angle_min, angle_increment, range_min, range_max,
+                            window_radius, valid.view(np.uint8), idx, rho, alpha)
+    idx, rho, alpha = idx[:k], rho[:k], alpha[:k]
     px, py = to_global(pose, rho, alpha)  # Eq. 1
     return Window(r, valid, idx, rho, alpha, px, py)
 

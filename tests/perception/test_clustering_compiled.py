@@ -1,6 +1,6 @@
-"""The clustering's compiled passes (``_loops.run_bounds``, ``run_shapes``,
-``edge_ranges`` and ``edge_codes``, what ``cluster_scan`` calls) give, to the bit, the
-obstacle chain of the numpy code they replaced, field by field."""
+"""The clustering's compiled passes (``_loops.window_beams``, ``run_bounds``,
+``run_shapes``, ``edge_ranges`` and ``edge_codes``, what ``cluster_scan`` calls) give, to
+the bit, the obstacle chain of the numpy code they replaced, field by field."""
 
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ from zenav.services.perception.clustering import (
     cluster_scan,
     grid_index,
     join_threshold,
+    scan_window,
     to_global,
 )
 from zenav.services.perception.params import PerceptionParams
@@ -143,6 +144,26 @@ def test_the_chain_is_the_numpy_one_to_the_bit(seed: int) -> None:
         same(got, want)
 
 
+@pytest.mark.parametrize("seed", range(20))
+def test_the_window_is_the_numpy_one_to_the_bit(seed: int) -> None:
+    """``scan_window`` (``_loops.window_beams``, then Eq. 1) against the numpy code it
+    replaced."""
+    rng = np.random.default_rng(500 + seed)
+    n = int(rng.choice([1, 3, 361, 720]))
+    ranges = random_ranges(rng, n)
+    pose = (float(rng.uniform(-20, 20)), float(rng.uniform(-20, 20)), float(rng.uniform(-7, 7)))
+    angle_min, radius = float(rng.uniform(-math.pi, 0.0)), float(rng.choice([3.0, 4.0, 9.0]))
+    got = scan_window(ranges, angle_min, HALF_DEG, 0.05, 8.0, pose, radius)
+    r = np.asarray(ranges, dtype=np.float64)
+    valid = (r >= 0.05) & (r < 8.0)
+    idx = np.flatnonzero(valid & (r <= radius))
+    alpha = angle_min + idx * HALF_DEG
+    px, py = to_global(pose, r[idx], alpha)
+    for a, b in zip((got.ranges, got.valid, got.beams, got.rho, got.alpha, got.x, got.y),
+                    (r, valid, idx, r[idx], alpha, px, py), strict=True):
+        assert (a.dtype, a.shape, a.tobytes()) == (b.dtype, b.shape, b.tobytes())
+
+
 def test_every_edge_code_and_the_speck_filter_occur() -> None:
     """The random scans above reach each edge code, and the speck filter drops runs."""
     codes: set[int] = set()
@@ -163,7 +184,8 @@ def test_every_edge_code_and_the_speck_filter_occur() -> None:
 
 def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
-    for name in ("run_bounds", "run_shapes", "edge_ranges", "edge_codes"):
+    for name in ("window_beams", "run_bounds", "run_shapes", "edge_ranges",
+                 "edge_codes"):
         real = getattr(_loops, name)
 
         def counted(*args: object, _real: object = real, _name: str = name) -> object:
@@ -173,7 +195,8 @@ def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -
         monkeypatch.setattr(_loops, name, counted)
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
-    assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes"]
+    assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes",
+                            "window_beams"]
 
 
 @pytest.mark.parametrize("seed", range(5))
