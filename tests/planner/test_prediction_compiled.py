@@ -105,7 +105,8 @@ def test_mover_numbers_are_their_definition() -> None:
         rel = (float(p[0] - r[0]), float(p[1] - r[1]))
         w = (float(v[0] - d[0] * speed), float(v[1] - d[1] * speed))
         dd, vv = (float(d[0]), float(d[1])), (float(v[0]), float(v[1]))
-        got = mover_numbers(*p.tolist(), *v.tolist(), *r.tolist(), *dd, speed)
+        got = mover_numbers(float(p[0]), float(p[1]), vv[0], vv[1], float(r[0]), float(r[1]),
+                            dd[0], dd[1], speed)
         assert got == (*rel, *w, fused_dot_exact(rel, dd), fused_dot_exact(vv, dd),
                        fused_dot_exact(w, w), fused_dot_exact(rel, w))
 
