@@ -38,6 +38,19 @@ cdef inline Py_ssize_t cell_index(double offset, double resolution) noexcept nog
     return i - (i > q)
 
 
+cdef inline unsigned char flag_at(double x, double y, double ox, double oy,
+                                  double resolution, const unsigned char[::1] grid,
+                                  Py_ssize_t nx, Py_ssize_t ny,
+                                  unsigned char outside) noexcept nogil:
+    """The flag of the cell (x, y) falls in (``Costmap.cell_of``'s arithmetic) in the
+    flat grid (``nx`` columns of ``ny`` cells), or ``outside`` beyond it."""
+    cdef Py_ssize_t ix = cell_index(x - ox, resolution)
+    cdef Py_ssize_t iy = cell_index(y - oy, resolution)
+    if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
+        return grid[ix * ny + iy]
+    return outside
+
+
 def floor_quotients(const double[::1] offsets, double resolution, long[::1] out):
     """``cell_index`` of every offset into ``out`` (for the tests that pin it to
     ``np.floor(offsets / resolution)``)."""
@@ -233,14 +246,10 @@ def look_up(const double[:, ::1] points, double ox, double oy, double resolution
     """For each point (x, y), the flag of the cell it falls in (``Costmap.cell_of``'s
     arithmetic) in the flat grid (``ny`` cells a column), or ``outside`` beyond it."""
     cdef Py_ssize_t nx = grid.shape[0] // ny
-    cdef Py_ssize_t i, ix, iy
+    cdef Py_ssize_t i
     for i in range(points.shape[0]):
-        ix = cell_index(points[i, 0] - ox, resolution)
-        iy = cell_index(points[i, 1] - oy, resolution)
-        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
-            out[i] = grid[ix * ny + iy]
-        else:
-            out[i] = outside
+        out[i] = flag_at(points[i, 0], points[i, 1], ox, oy, resolution, grid, nx, ny,
+                         outside)
 
 
 @cython.cdivision(True)
@@ -255,10 +264,9 @@ def first_flagged_on(const double[:, ::1] points, const double[::1] lengths,
     length, else slope (s - length_j) + value_j on segment j (from its far end if
     that gives nan, and the near end's value if both do and the ends are equal)."""
     cdef Py_ssize_t n = lengths.shape[0], nx = grid.shape[0] // ny
-    cdef Py_ssize_t i, j = 0, k, ix, iy
+    cdef Py_ssize_t i, j = 0, k
     cdef double x, slope
     cdef double at[2]
-    cdef unsigned char flag
     for i in range(s.shape[0]):
         x = s[i]
         for k in range(2):
@@ -281,13 +289,7 @@ def first_flagged_on(const double[:, ::1] points, const double[::1] lengths,
                         at[k] = slope * (x - lengths[j + 1]) + points[j + 1, k]
                         if isnan(at[k]) and points[j, k] == points[j + 1, k]:
                             at[k] = points[j, k]
-        ix = cell_index(at[0] - ox, resolution)
-        iy = cell_index(at[1] - oy, resolution)
-        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
-            flag = grid[ix * ny + iy]
-        else:
-            flag = outside
-        if flag:
+        if flag_at(at[0], at[1], ox, oy, resolution, grid, nx, ny, outside):
             return i
     return -1
 
@@ -326,13 +328,11 @@ def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, do
     flagged cell of the flat grid (``ny`` cells a column; beyond it: no), each found as
     ``look_up`` finds it."""
     cdef Py_ssize_t nx = grid.shape[0] // ny
-    cdef Py_ssize_t i, k, ix, iy
+    cdef Py_ssize_t i, k
     for i in range(xs.shape[0]):
         out[i] = 0
         for k in range(xs.shape[1]):
-            ix = cell_index(xs[i, k] - ox, resolution)
-            iy = cell_index(ys[i, k] - oy, resolution)
-            if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny) and grid[ix * ny + iy]:
+            if flag_at(xs[i, k], ys[i, k], ox, oy, resolution, grid, nx, ny, 0):
                 out[i] = 1
                 break
 
@@ -500,18 +500,11 @@ def line_any(double sx, double sy, double dx, double dy, double length, Py_ssize
     along (dx, dy) for ``length`` m falls in a flagged cell of the flat grid (``ny``
     cells a column; ``outside`` beyond it), as ``look_up`` finds each point's flag."""
     cdef Py_ssize_t nx = grid.shape[0] // ny
-    cdef Py_ssize_t i, ix, iy
+    cdef Py_ssize_t i
     cdef double step = length / <double>(count - 1), s
-    cdef unsigned char flag
     for i in range(count):
         s = spaced(i, count, length, step)
-        ix = cell_index(sx + s * dx - ox, resolution)
-        iy = cell_index(sy + s * dy - oy, resolution)
-        if (<size_t>ix < <size_t>nx) & (<size_t>iy < <size_t>ny):
-            flag = grid[ix * ny + iy]
-        else:
-            flag = outside
-        if flag:
+        if flag_at(sx + s * dx, sy + s * dy, ox, oy, resolution, grid, nx, ny, outside):
             return True
     return False
 
