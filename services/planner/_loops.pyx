@@ -51,6 +51,13 @@ cdef inline unsigned char flag_at(double x, double y, double ox, double oy,
     return outside
 
 
+cdef inline double dot(double ax, double ay, double bx, double by) noexcept nogil:
+    """a . b as numpy's ``@`` gives it for two 2-vectors here (its BLAS): the product of
+    the x parts, rounded, then the y parts' product added with one rounding, a fused
+    multiply-add: fma(a_y, b_y, a_x b_x)."""
+    return fma(ay, by, ax * bx)
+
+
 def floor_quotients(const double[::1] offsets, double resolution, long[::1] out):
     """``cell_index`` of every offset into ``out`` (for the tests that pin it to
     ``np.floor(offsets / resolution)``)."""
@@ -218,7 +225,7 @@ def returns_near(const unsigned char[::1] occupied, const double[::1] seen, Py_s
     (``ny`` cells a column) is occupied and was seen at ``since`` or later, with its
     centre (``Costmap.centre_of``) within ``distance`` of the segment from (ax, ay) to
     (bx, by): the nearest point of the segment at the clipped projection of the centre
-    on it, its gap by ``hypot``. An infinite ``distance`` asks only for such a cell."""
+    on it, its gap by ``hypot`` (an infinite ``distance``: any such cell)."""
     cdef Py_ssize_t i, j, cell
     cdef double dx = bx - ax, dy = by - ay
     cdef double length2 = dx * dx + dy * dy
@@ -228,8 +235,6 @@ def returns_near(const unsigned char[::1] occupied, const double[::1] seen, Py_s
             cell = i * ny + j
             if not occupied[cell] or not seen[cell] >= since:
                 continue
-            if distance == INFINITY:
-                return True
             rx = ox + (<double>i + 0.5) * resolution - ax
             ry = oy + (<double>j + 0.5) * resolution - ay
             t = 0.0
@@ -563,8 +568,8 @@ def straight_on(const double[:, ::1] points, const double[::1] lengths, double s
     along (dx, dy) (unit), from arc length ``s0`` on (the robot's projection): the
     distance to the last vertex past ``s0 + 1e-6`` before the first whose leg from
     (rx, ry) turns off the direction (cosine under 0.999; a vertex within 1e-9 m never
-    does), 0 when the first one does. The cosine is the dot product over ``hypot``,
-    the dot product a fused multiply-add (fma(l_y, d_y, l_x d_x), numpy's ``@`` here)."""
+    does), 0 when the first one does. The cosine is the dot product (``dot``) over
+    ``hypot``."""
     cdef Py_ssize_t i = 0, n = points.shape[0]
     cdef double lx, ly, d
     cdef double end = 0.0
@@ -574,7 +579,7 @@ def straight_on(const double[:, ::1] points, const double[::1] lengths, double s
         lx = points[i, 0] - rx
         ly = points[i, 1] - ry
         d = hypot(lx, ly)
-        if d > 1e-9 and fma(ly, dy, lx * dx) / d < 0.999:
+        if d > 1e-9 and dot(lx, ly, dx, dy) / d < 0.999:
             break
         end = d
         i += 1
@@ -648,8 +653,8 @@ def c_hypot(double x, double y):
 
 
 def fused_dot(double ax, double ay, double bx, double by):
-    """a . b = fma(a_y, b_y, a_x b_x), as ``mover_numbers`` takes its dot products."""
-    return fma(ay, by, ax * bx)
+    """a . b by ``dot`` (fma(a_y, b_y, a_x b_x)), for Python callers."""
+    return dot(ax, ay, bx, by)
 
 
 def mover_numbers(double px, double py, double vx, double vy, double rx, double ry,
@@ -658,13 +663,11 @@ def mover_numbers(double px, double py, double vx, double vy, double rx, double 
     (dx, dy) (unit) at ``speed``: its centre from the robot, its velocity relative to the
     robot's, and four dot products, as ``prediction.assess_all`` takes them: rel . d
     (how far ahead), v . d (its speed along the robot's way), w . w and rel . w (for the
-    closest approach), w the relative velocity. Each dot product is a . b = fma(a_y, b_y,
-    a_x b_x): the product of the x parts, rounded, then the y parts' product added with
-    one rounding (a fused multiply-add), as the BLAS dot product numpy called gave them."""
+    closest approach), w the relative velocity; each dot product by ``dot``."""
     cdef double relx = px - rx, rely = py - ry
     cdef double wx = vx - dx * speed, wy = vy - dy * speed
-    return (relx, rely, wx, wy, fma(rely, dy, relx * dx), fma(vy, dy, vx * dx),
-            fma(wy, wy, wx * wx), fma(rely, wy, relx * wx))
+    return (relx, rely, wx, wy, dot(relx, rely, dx, dy), dot(vx, vy, dx, dy),
+            dot(wx, wy, wx, wy), dot(relx, rely, wx, wy))
 
 
 @cython.cdivision(True)

@@ -203,32 +203,11 @@ SETTLE_BEARINGS = 36
 """Points looked at on each ring round the goal by ``settle_point`` (every 10 degrees)."""
 
 
-def _squares_near(costmap: Costmap, point: Vec, span: float) -> Vec:
-    """The lower corners (m, 2) of the lethal cells whose squares meet the box ``point``
-    ± ``span`` (every lethal cell nearer than ``span`` to the point is among them)."""
-    corners = costmap.cell_of(np.vstack([point - span, point + span]))
-    lo = np.maximum(corners[0], 0)
-    hi = np.minimum(corners[1] + 1, costmap.shape)
-    if (hi <= lo).any():
-        return np.empty((0, 2))
-    near = np.argwhere(costmap.lethal_grid()[lo[0]:hi[0], lo[1]:hi[1]]) + lo
-    corner: Vec = costmap.origin + near * costmap.resolution
-    return corner
-
-
-def _clear_of(low: Vec, side: float, points: Vec, clearance: float) -> npt.NDArray[np.bool_]:
-    """Per point (n, 2), whether every square (lower corners ``low``, sides ``side``)
-    lies at least ``clearance`` from it."""
-    dx = np.maximum(np.maximum(low[None, :, 0] - points[:, None, 0], 0.0),
-                    points[:, None, 0] - (low[None, :, 0] + side))
-    dy = np.maximum(np.maximum(low[None, :, 1] - points[:, None, 1], 0.0),
-                    points[:, None, 1] - (low[None, :, 1] + side))
-    return np.asarray(np.hypot(dx, dy).min(axis=1) >= clearance)
-
-
 def goal_clear(costmap: Costmap, goal: Vec, clearance: float) -> bool:
-    """Whether every occupied cell's square lies at least ``clearance`` from ``goal``:
-    ``settle_point``'s answer is then the goal itself, whatever its reach."""
+    """Whether every occupied cell's square lies at least ``clearance`` from ``goal`` (any
+    point): ``settle_point``'s answer is then the goal itself, whatever its reach. Only
+    the cells whose squares meet the box ``goal`` +- (``clearance`` + a cell) can be
+    nearer, and only those are looked at (``Costmap.squares_clear``)."""
     return costmap.squares_clear((float(goal[0]), float(goal[1])),
                                  clearance + costmap.resolution, clearance)
 
@@ -248,16 +227,14 @@ def settle_point(costmap: Costmap, goal: Vec, toward: Vec, clearance: float,
     its cell, so the square is the nearest the obstacle can be); the space beyond the
     grid holds nothing known."""
     goal = np.asarray(goal, dtype=np.float64)
-    r = costmap.resolution
     if goal_clear(costmap, goal, clearance):
         return goal
-    low = _squares_near(costmap, goal, reach + clearance + r)
     angles = np.linspace(0.0, 2.0 * math.pi, SETTLE_BEARINGS, endpoint=False)
     ring = np.column_stack([np.cos(angles), np.sin(angles)])
-    step = r / 2
+    step = costmap.resolution / 2
     for k in range(1, int(reach / step + 1e-9) + 1):
         points = goal + (k * step) * ring
-        ok = _clear_of(low, r, points, clearance)
+        ok = np.array([goal_clear(costmap, point, clearance) for point in points])
         if ok.any():
             found = points[ok]
             return np.asarray(found[int(np.argmin(np.hypot(*(found - toward).T)))])
