@@ -1,12 +1,13 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
 """Perception's compiled inner loops (Cython, built at install): the clustering's
-passes over points and runs (the Eq. 3 cuts, each run's box, end points and radius, the
-edge codes) and the motion cue's (the free-space test, point by point, the grouping of
-a scan's points by cluster and the scores against an earlier scan), with the
-floating-point operations of the numpy code they replaced, in the same order (the
-bearing wrapped by ``_angles.pxi``). ``clustering.py`` and ``motion_cue.py`` own the
-meaning and the equations (Eq. 3's threshold comes in as an array from
-``clustering.join_threshold``); ``_loops.pyi`` gives the types."""
+passes over the scan, its points and runs (the window, the Eq. 3 cuts, each run's box,
+end points and radius, the edge codes) and the motion cue's (the free-space test, point
+by point, the grouping of a scan's points by cluster and the scores against an earlier
+scan), with the floating-point operations of the numpy code they replaced, in the same
+order (the bearing wrapped by ``_angles.pxi``). The paper's Eqs. 1, 2, 3 and 6 are
+written once, in ``_equations.pxi``; the array forms here are what ``clustering.py``'s
+equation functions call. ``clustering.py`` and ``motion_cue.py`` own the meaning;
+``_loops.pyi`` gives the types."""
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from libc.math cimport INFINITY, atan2, fabs, hypot, rint, sqrt
 from libc.stdlib cimport calloc, free
 
 include "../_angles.pxi"
+include "_equations.pxi"
 
 
 cdef inline bint free_at(double px, double py, double x, double y, double heading,
@@ -148,36 +150,91 @@ def free_scores(const double[:, ::1] points, const long[::1] member, const long[
         free(entered)
 
 
-def window_beams(const double[::1] ranges, double angle_min, double angle_increment,
-                 double range_min, double range_max, double window_radius,
-                 unsigned char[::1] valid, long[::1] beams, double[::1] rho,
-                 double[::1] alpha):
-    """The masks and indices of ``clustering.scan_window`` in one pass: into ``valid``
-    whether each beam has a return (``range_min <= r < range_max``; nan has none), and,
-    filled from the front, the beams with a return within ``window_radius``, their
-    ranges and their angles (angle_min + i angle_increment, numpy's arithmetic).
-    Returns how many there are."""
+def to_global_into(double x, double y, double heading, const double[::1] rho,
+                   const double[::1] alpha, double[::1] gx, double[::1] gy):
+    """Eq. 1 (``_equations.pxi``) for each (rho, alpha) seen from the robot at (x, y,
+    heading), into ``gx`` and ``gy``: ``clustering.to_global``."""
+    cdef Py_ssize_t i
+    for i in range(rho.shape[0]):
+        gx[i] = eq1_x(x, heading, rho[i], alpha[i])
+        gy[i] = eq1_y(y, heading, rho[i], alpha[i])
+
+
+def to_global_rows(double x, double y, double heading, const double[::1] rho,
+                   const double[::1] alpha, double[:, ::1] out):
+    """Eq. 1 as :func:`to_global_into`, into the rows (x, y) of ``out``."""
+    cdef Py_ssize_t i
+    for i in range(rho.shape[0]):
+        out[i, 0] = eq1_x(x, heading, rho[i], alpha[i])
+        out[i, 1] = eq1_y(y, heading, rho[i], alpha[i])
+
+
+def grid_index_into(const double[::1] coord, double cell, long[::1] out):
+    """Eq. 2 (``_equations.pxi``) of each coordinate: ``clustering.grid_index``."""
+    cdef Py_ssize_t i
+    for i in range(coord.shape[0]):
+        out[i] = eq2(coord[i], cell)
+
+
+def join_threshold_into(const double[::1] rho, double lambda_, double step, double gap_floor,
+                        double[::1] out):
+    """Eq. 3 (``_equations.pxi``) of each range: ``clustering.join_threshold``."""
+    cdef Py_ssize_t i
+    for i in range(rho.shape[0]):
+        out[i] = eq3(rho[i], lambda_, step, gap_floor)
+
+
+cpdef long box_area(long ix_min, long ix_max, long iy_min, long iy_max):
+    """Eq. 6 (``_equations.pxi``) of one grid box: ``clustering.box_area``."""
+    return eq6(ix_min, ix_max, iy_min, iy_max)
+
+
+def box_areas_into(const long[:, ::1] boxes, long[::1] out):
+    """Eq. 6 of each row of ``boxes``: ``clustering.box_area`` of an array."""
+    cdef Py_ssize_t i
+    for i in range(boxes.shape[0]):
+        out[i] = eq6(boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3])
+
+
+def window_points(const double[::1] ranges, double angle_min, double angle_increment,
+                  double range_min, double range_max, double window_radius, double x,
+                  double y, double heading, unsigned char[::1] valid, long[::1] beams,
+                  double[::1] rho, double[::1] alpha, double[::1] px, double[::1] py,
+                  double[:, ::1] xy):
+    """The window of ``clustering.scan_window`` in one pass: into ``valid`` whether each
+    beam has a return (``range_min <= r < range_max``; nan has none), and, filled from
+    the front, the beams with a return within ``window_radius``, their ranges, their
+    angles (angle_min + i angle_increment, numpy's arithmetic) and their global points
+    by Eq. 1 from the robot at (x, y, heading), in ``px`` and ``py`` and as the rows of
+    ``xy``. Returns how many there are."""
     cdef Py_ssize_t i, k = 0
-    cdef double r
+    cdef double r, a
     cdef bint has
     for i in range(ranges.shape[0]):
         r = ranges[i]
         has = r >= range_min and r < range_max
         valid[i] = has
         if has and r <= window_radius:
+            a = angle_min + <double>i * angle_increment
             beams[k] = i
             rho[k] = r
-            alpha[k] = angle_min + <double>i * angle_increment
+            alpha[k] = a
+            px[k] = eq1_x(x, heading, r, a)
+            py[k] = eq1_y(y, heading, r, a)
+            xy[k, 0] = px[k]
+            xy[k, 1] = py[k]
             k += 1
     return k
 
 
-def run_bounds(const double[::1] px, const double[::1] py, const double[::1] threshold,
-               long[::1] starts, long[::1] ends, long[::1] counts):
-    """Cut the chain of points ``(px, py)`` where two consecutive points lie farther
-    apart than ``threshold`` (of the later point; ``threshold[i - 1]`` for points
-    ``i - 1`` and ``i``, compared squared): the first and last point and the number of
-    points of each run (``starts``, ``ends``, ``counts``, filled from the front).
+def run_bounds(const double[::1] px, const double[::1] py, const double[::1] rho,
+               double lambda_, double step, double gap_floor, long[::1] starts,
+               long[::1] ends, long[::1] counts):
+    """Cut the chain of points ``(px, py)`` at ranges ``rho`` where two consecutive
+    points lie farther apart than Eq. 3's join threshold of the later point (compared
+    squared; ``lambda_``, ``step`` = sin|d_alpha| and ``gap_floor`` as
+    ``clustering.join_threshold`` takes them): the first and last point and the number
+    of points of each run (``starts``, ``ends``, ``counts``, filled from the front).
     Returns the number of runs."""
     cdef Py_ssize_t m = px.shape[0]
     cdef Py_ssize_t i
@@ -187,7 +244,7 @@ def run_bounds(const double[::1] px, const double[::1] py, const double[::1] thr
     for i in range(1, m):
         dx = px[i] - px[i - 1]
         dy = py[i] - py[i - 1]
-        t = threshold[i - 1]
+        t = eq3(rho[i], lambda_, step, gap_floor)
         if dx * dx + dy * dy > t * t:
             ends[k - 1] = i - 1
             starts[k] = i
@@ -199,13 +256,14 @@ def run_bounds(const double[::1] px, const double[::1] py, const double[::1] thr
 
 
 def run_shapes(const double[::1] px, const double[::1] py, const long[::1] starts,
-               const long[::1] ends, double inset, double[:, ::1] edges,
-               double[:, ::1] first_point, double[:, ::1] last_point, double[:, ::1] chord,
-               double[::1] radius):
-    """For each run of points ``starts[c]..ends[c]``: its bounding box shrunk by
-    ``inset`` on each side, never past its middle (``edges``: x_min, x_max, y_min,
-    y_max), its first and last point, their midpoint (``chord``) and the largest
-    distance from that midpoint to a point of the run (``radius``)."""
+               const long[::1] ends, double inset, double cell, long[:, ::1] box,
+               long[::1] area, double[:, ::1] first_point, double[:, ::1] last_point,
+               double[:, ::1] chord, double[::1] radius):
+    """For each run of points ``starts[c]..ends[c]``: the grid box (Eq. 2 of each edge:
+    ix_min, ix_max, iy_min, iy_max) of its bounding box shrunk by ``inset`` on each side,
+    never past its middle, and that box's Eq. 6 ``area``; its first and last point,
+    their midpoint (``chord``) and the largest distance from that midpoint to a point of
+    the run (``radius``)."""
     cdef Py_ssize_t c, i
     cdef double lo_x, hi_x, lo_y, hi_y, in_x, in_y, cx, cy, ex, ey, d2, far
     for c in range(starts.shape[0]):
@@ -218,10 +276,11 @@ def run_shapes(const double[::1] px, const double[::1] py, const long[::1] start
             hi_y = max(hi_y, py[i])
         in_x = min(inset, (hi_x - lo_x) / 2)
         in_y = min(inset, (hi_y - lo_y) / 2)
-        edges[c, 0] = lo_x + in_x
-        edges[c, 1] = hi_x - in_x
-        edges[c, 2] = lo_y + in_y
-        edges[c, 3] = hi_y - in_y
+        box[c, 0] = eq2(lo_x + in_x, cell)
+        box[c, 1] = eq2(hi_x - in_x, cell)
+        box[c, 2] = eq2(lo_y + in_y, cell)
+        box[c, 3] = eq2(hi_y - in_y, cell)
+        area[c] = eq6(box[c, 0], box[c, 1], box[c, 2], box[c, 3])
         first_point[c, 0] = px[starts[c]]
         first_point[c, 1] = py[starts[c]]
         last_point[c, 0] = px[ends[c]]
@@ -239,47 +298,32 @@ def run_shapes(const double[::1] px, const double[::1] py, const long[::1] start
         radius[c] = sqrt(far)
 
 
-def edge_ranges(const double[::1] ranges, const unsigned char[::1] valid,
-                const long[:, ::1] beams, double[:, ::1] rho_edge,
-                double[:, ::1] rho_next, double[:, ::1] rho_top,
-                unsigned char[:, ::1] has, unsigned char[:, ::1] outside):
-    """For each end of each cluster (``beams``: first, last beam), the beam beside it
-    (first - 1, last + 1): whether it lies outside the scan (``outside``), whether it has
-    a return (``has``, ``valid`` there), the range at the end (``rho_edge``), the
-    neighbour's range (``rho_next``, 0 without a return) and the larger of the two
-    (``rho_top``)."""
+def edge_codes(const double[::1] ranges, const unsigned char[::1] valid,
+               const long[:, ::1] beams, double lambda_, double step, double gap_floor,
+               double cos2, double window_radius, long[:, ::1] codes):
+    """The code of what lies beside each end of each cluster (``beams``: first, last
+    beam), from the beam beside it (first - 1, last + 1): 2 (clipped) when that beam lies
+    outside the scan, or has a return beyond ``window_radius`` within Eq. 3's join
+    threshold of the larger of the two ranges of the end point (the distance by the law
+    of cosines; ``cos2``: twice the cosine of the beam step); else 1 (occluded) when it
+    has a return nearer than the end by more than the join threshold of the end's range;
+    else 0. (``lambda_``, ``step`` and ``gap_floor`` as :func:`run_bounds` takes them.)"""
     cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t c, j, b
+    cdef bint outside, has
+    cdef double re, rn, d2, t
     for c in range(beams.shape[0]):
         for j in range(2):
             b = beams[c, j] + (1 if j else -1)
-            outside[c, j] = b < 0 or b >= n
-            has[c, j] = (not outside[c, j]) and valid[b]
-            rho_edge[c, j] = ranges[beams[c, j]]
-            rho_next[c, j] = ranges[b] if has[c, j] else 0.0
-            rho_top[c, j] = max(rho_edge[c, j], rho_next[c, j])
-
-
-def edge_codes(const double[:, ::1] rho_edge, const double[:, ::1] rho_next,
-               const unsigned char[:, ::1] has, const unsigned char[:, ::1] outside,
-               const double[:, ::1] join_top, const double[:, ::1] join_edge,
-               double cos2, double window_radius, long[:, ::1] codes):
-    """The code of what lies beside each end (``edge_ranges`` gave the ranges):
-    2 (clipped) outside the scan, or for a return beyond ``window_radius`` within
-    ``join_top`` (the join threshold of the larger range) of the end point, the distance
-    by the law of cosines (``cos2``: twice the cosine of the beam step); else 1
-    (occluded) for a return nearer than the end by more than ``join_edge``; else 0."""
-    cdef Py_ssize_t c, j
-    cdef double re, rn, d2, t
-    for c in range(rho_edge.shape[0]):
-        for j in range(2):
-            re = rho_edge[c, j]
-            rn = rho_next[c, j]
+            outside = b < 0 or b >= n
+            has = (not outside) and valid[b]
+            re = ranges[beams[c, j]]
+            rn = ranges[b] if has else 0.0
             d2 = re * re + rn * rn - cos2 * re * rn
-            t = join_top[c, j]
-            if outside[c, j] or (has[c, j] and rn > window_radius and d2 <= t * t):
+            t = eq3(max(re, rn), lambda_, step, gap_floor)
+            if outside or (has and rn > window_radius and d2 <= t * t):
                 codes[c, j] = 2
-            elif has[c, j] and rn < re - join_edge[c, j]:
+            elif has and rn < re - eq3(re, lambda_, step, gap_floor):
                 codes[c, j] = 1
             else:
                 codes[c, j] = 0

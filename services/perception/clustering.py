@@ -2,8 +2,10 @@
 
 Pure functions: :func:`cluster_scan` takes the scan in the ROS LaserScan convention and the
 robot pose at scan time, and returns a :class:`Clusters` record, one row per obstacle in scan
-order (the obstacle chain O_chain(t) of Eq. 4). The equations are numpy functions of this
-module; the passes over points and runs between them are compiled (``_loops.pyx``).
+order (the obstacle chain O_chain(t) of Eq. 4). The equations are functions of this module;
+Eqs. 1, 2, 3 and 6 are written once in compiled code (``_equations.pxi``), which these
+functions and the compiled passes over the scan, its points and runs (``_loops.pyx``)
+both use.
 
 Conventions
 -----------
@@ -170,17 +172,28 @@ def to_global(
     """Eq. 1: global (x, y) of the points at range ``rho`` and beam angle ``alpha``.
 
     ``alpha`` is counter-clockwise from the heading (see the module notes), so the paper's
-    ``theta_R - alpha_i`` reads ``theta_R + alpha`` here.
+    ``theta_R - alpha_i`` reads ``theta_R + alpha`` here: ``x_R + rho cos(theta_R +
+    alpha)``, ``y_R + rho sin(theta_R + alpha)``. Compiled (``_equations.pxi``, the
+    lines the window and the cluster centres use too); ``rho`` and ``alpha`` broadcast.
     """
     x_r, y_r, th_r = pose
-    r = np.asarray(rho, dtype=np.float64)
-    ang = th_r + np.asarray(alpha, dtype=np.float64)
-    return x_r + r * np.cos(ang), y_r + r * np.sin(ang)
+    r, a = np.asarray(rho, dtype=np.float64), np.asarray(alpha, dtype=np.float64)
+    if r.shape != a.shape:
+        r, a = np.broadcast_arrays(r, a)
+    gx, gy = np.empty(r.shape), np.empty(r.shape)
+    _loops.to_global_into(float(x_r), float(y_r), float(th_r),
+                          np.ascontiguousarray(r).reshape(-1),
+                          np.ascontiguousarray(a).reshape(-1), gx.reshape(-1), gy.reshape(-1))
+    return gx, gy
 
 
 def grid_index(coord: npt.ArrayLike, cell: float) -> IntArray:
-    """Eq. 2: grid index ``floor(coord / r + 1/2)`` (cell k is centred on k * r)."""
-    return np.floor(np.asarray(coord, dtype=np.float64) / cell + 0.5).astype(np.int64)
+    """Eq. 2: grid index ``floor(coord / r + 1/2)`` (cell k is centred on k * r).
+    Compiled (``_equations.pxi``, the lines the cluster boxes use too)."""
+    c = np.asarray(coord, dtype=np.float64)
+    out = np.empty(c.shape, dtype=np.int64)
+    _loops.grid_index_into(np.ascontiguousarray(c).reshape(-1), cell, out.reshape(-1))
+    return out
 
 
 # (A tuple is array-like too, so the two forms overlap for mypy; the tuple's comes first.)
@@ -191,12 +204,13 @@ def box_area(box: npt.ArrayLike) -> IntArray: ...
 def box_area(box: npt.ArrayLike) -> int | IntArray:
     """Eq. 6: cells in an inclusive grid box ``(ix_min, ix_max, iy_min, iy_max)``, or in
     each row of an array of boxes. One box as a tuple of Python ints (as the tracker keeps
-    them) gives a Python int, without the cost of a numpy call for four numbers."""
+    them) gives a Python int. Compiled (``_equations.pxi``, the lines the cluster areas
+    use too)."""
     if isinstance(box, tuple):
-        cells: int = (box[1] - box[0] + 1) * (box[3] - box[2] + 1)
-        return cells
+        return _loops.box_area(*box)
     b = np.asarray(box, dtype=np.int64)
-    area: IntArray = (b[..., 1] - b[..., 0] + 1) * (b[..., 3] - b[..., 2] + 1)
+    area = np.empty(b.shape[:-1], dtype=np.int64)
+    _loops.box_areas_into(np.ascontiguousarray(b).reshape(-1, 4), area.reshape(-1))
     return area
 
 
@@ -207,10 +221,15 @@ def join_threshold(
 
     ``theta = lambda * rho * sin(d_alpha) + gap_floor``; ``d_alpha`` is the scan's own angular
     step (0.5 degrees for the paper's scanner), ``rho`` the range of the current point.
-    ``gap_floor`` is 0 in the paper (see PerceptionParams).
+    ``gap_floor`` is 0 in the paper (see PerceptionParams). Compiled (``_equations.pxi``,
+    the lines the cuts and the edge codes use too).
     """
-    step = math.sin(abs(angle_increment))
-    return params.lambda_ * np.asarray(rho, dtype=np.float64) * step + params.gap_floor
+    r = np.asarray(rho, dtype=np.float64)
+    out = np.empty(r.shape)
+    _loops.join_threshold_into(np.ascontiguousarray(r).reshape(-1), params.lambda_,
+                               math.sin(abs(angle_increment)), params.gap_floor,
+                               out.reshape(-1))
+    return out
 
 
 def cluster_means(
@@ -242,6 +261,7 @@ class Window:
         alpha: (k,) their angles relative to the heading, radians.
         x: (k,) their global points (Eq. 1), metres.
         y: (k,)
+        points: (k, 2) the same points as rows (x, y).
     """
 
     ranges: FloatArray
@@ -251,6 +271,7 @@ class Window:
     alpha: FloatArray
     x: FloatArray
     y: FloatArray
+    points: FloatArray
 
 
 def scan_window(
@@ -268,14 +289,15 @@ def scan_window(
     n = r.shape[0]
     valid = np.empty(n, dtype=np.bool_)
     idx = np.empty(n, dtype=np.int64)
-    rho, alpha = np.empty(n), np.empty(n)
-    # The masks, the window's beams, ranges and angles in one compiled pass (NaN
-    # compares False everywhere, so it drops out as "no return" like inf does).
-    k = _loops.window_beams(r, angle_min, angle_increment, range_min, range_max,
-                            window_radius, valid.view(np.uint8), idx, rho, alpha)
-    idx, rho, alpha = idx[:k], rho[:k], alpha[:k]
-    px, py = to_global(pose, rho, alpha)  # Eq. 1
-    return Window(r, valid, idx, rho, alpha, px, py)
+    rho, alpha, px, py = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    xy = np.empty((n, 2))
+    # The masks, the window's beams, ranges, angles and points (Eq. 1) in one compiled
+    # pass (NaN compares False everywhere, so it drops out as "no return" like inf does).
+    x, y, heading = pose
+    k = _loops.window_points(r, angle_min, angle_increment, range_min, range_max,
+                             window_radius, x, y, heading, valid.view(np.uint8), idx, rho,
+                             alpha, px, py, xy)
+    return Window(r, valid, idx[:k], rho[:k], alpha[:k], px[:k], py[:k], xy[:k])
 
 
 def full_circle(n_beams: int, angle_increment: float) -> int:
@@ -365,10 +387,10 @@ def cluster_window(
 
     # Eq. 3: a new cluster starts where the distance to the previous point exceeds theta
     # (compared squared, both sides are non-negative; compiled, one pass).
-    thr = join_threshold(rho[1:], angle_increment, params)
     m = idx.size
     starts, ends, counts = (np.empty(m, dtype=np.int64) for _ in range(3))
-    k = _loops.run_bounds(px, py, thr, starts, ends, counts)
+    k = _loops.run_bounds(px, py, rho, params.lambda_, math.sin(abs(angle_increment)),
+                          params.gap_floor, starts, ends, counts)
     starts, ends, counts = starts[:k], ends[:k], counts[:k]
 
     if params.min_beams > 1:
@@ -387,23 +409,24 @@ def cluster_window(
 
     # Eq. 5: mean alpha and mean rho, then Eq. 1 for the global centre.
     mean_rho, mean_alpha = cluster_means(rho, alpha, starts, counts)
-    centre = np.column_stack(to_global(pose, mean_rho, mean_alpha))
+    centre = np.empty((k, 2))
+    _loops.to_global_rows(x_r, y_r, th_r, mean_rho, mean_alpha, centre)
 
     # Eq. 2 on every point, Eq. 6 box over all of them (S_k's edges, see the module notes).
     # The metric bounding box is shrunk by ``edge_inset`` on each side (never past its
     # middle) before Eq. 2: an obstacle edge that lies on a cell boundary, as the edges
     # of boxes laid out on the grid do, then stays in the obstacle's cell instead of
     # spilling into the free one beside it, whichever way range noise moved the point.
-    # The boxes, end points, chord centres and radii in one compiled pass over the runs.
-    edges = np.empty((k, 4))
+    # The boxes (Eq. 2 of the edges: ix_min, ix_max, iy_min, iy_max), their areas (Eq. 6),
+    # end points, chord centres and radii in one compiled pass over the runs.
+    box = np.empty((k, 4), dtype=np.int64)
+    area = np.empty(k, dtype=np.int64)
     first_point = np.empty((k, 2))
     last_point = np.empty((k, 2))
     chord = np.empty((k, 2))
     radius = np.empty(k)
-    _loops.run_shapes(px, py, starts, ends, params.edge_inset, edges, first_point, last_point,
-                      chord, radius)
-    box = grid_index(edges, cell)  # Eq. 2: ix_min, ix_max, iy_min, iy_max
-    area = box_area(box)  # Eq. 6
+    _loops.run_shapes(px, py, starts, ends, params.edge_inset, cell, box, area, first_point,
+                      last_point, chord, radius)
 
     beams = np.empty((k, 2), dtype=np.int64)
     beams[:, 0] = idx[starts]
@@ -453,17 +476,11 @@ def _edge_codes(
     * a return nearer than the edge point by more than the join threshold -> EDGE_OCCLUDED;
     * anything else (background behind, or a surface that did not join) -> EDGE_FREE.
     """
-    k = beams.shape[0]
-    rho_edge, rho_next, rho_top = np.empty((k, 2)), np.empty((k, 2)), np.empty((k, 2))
-    has, outside = np.empty((k, 2), dtype=np.uint8), np.empty((k, 2), dtype=np.uint8)
-    _loops.edge_ranges(r, valid.view(np.uint8), beams, rho_edge, rho_next, rho_top, has,
-                       outside)
-    codes = np.empty((k, 2), dtype=np.int64)
+    codes = np.empty((beams.shape[0], 2), dtype=np.int64)
     # Eq. 3 of the larger range (would the neighbour have joined?) and of the end's own
     # range (is the neighbour nearer by more than that?); the distance between the two
-    # points by the law of cosines (the angle between them is known).
-    _loops.edge_codes(rho_edge, rho_next, has, outside,
-                      join_threshold(rho_top, angle_increment, params),
-                      join_threshold(rho_edge, angle_increment, params),
+    # points by the law of cosines (the angle between them is known). One compiled pass.
+    _loops.edge_codes(r, valid.view(np.uint8), beams, params.lambda_,
+                      math.sin(abs(angle_increment)), params.gap_floor,
                       2.0 * math.cos(angle_increment), params.window_radius, codes)
     return codes

@@ -159,7 +159,7 @@ class MotionCue:
             window = scan_window(scan.ranges, scan.angle_min, scan.angle_increment, range_min,
                                  scan.range_max, scan.pose, self.window_radius)
         # The window's global points, once per scan, kept for the scans after it.
-        beams, points = window.beams, np.column_stack((window.x, window.y))
+        beams, points = window.beams, window.points
         scores = np.zeros((len(cluster_beams), len(self.baselines)))
         stamps = np.full(len(self.baselines), np.nan)
         # The clusters' points and boxes once, for every baseline.

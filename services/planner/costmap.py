@@ -176,9 +176,10 @@ class Costmap:
         self._disc = _disc_offsets(resolution, inflation)
         self._clearance_discs: dict[float, tuple[npt.NDArray[np.int_], npt.NDArray[np.int_]]] = {}
         self._returned = np.zeros(0, dtype=np.uint8)  # per flat cell: a mark of this scan
-        # The beams' angles from the heading, and the (angle_min, angle_increment, count)
-        # they were made for.
-        self._beams: tuple[tuple[float, float, int], npt.NDArray[np.float64]] | None = None
+        # The (angle_min, angle_increment, count) of the beams, their angles from the
+        # heading, and a range of 1 m for each (for their directions).
+        self._beams: tuple[tuple[float, float, int], npt.NDArray[np.float64],
+                           npt.NDArray[np.float64]] | None = None
 
     # -- geometry ----------------------------------------------------------------------
 
@@ -257,12 +258,12 @@ class Costmap:
         beams = (scan.angle_min, scan.angle_increment, ranges.size)
         if self._beams is None or self._beams[0] != beams:  # the same laser, scan after scan
             self._beams = (beams, np.asarray(scan.angle_min + scan.angle_increment
-                                             * np.arange(ranges.size), dtype=np.float64))
-        alpha = self._beams[1]
+                                             * np.arange(ranges.size), dtype=np.float64),
+                           np.ones(ranges.size))
+        _, alpha, unit = self._beams
         # Each beam's unit direction in the global frame (Eq. 1 at rho = 1 m from the
         # robot); a return lies at the robot plus its range times that (Eq. 1 again).
-        ux, uy = to_global((0.0, 0.0, heading), 1.0, alpha)
-        ux, uy = np.ascontiguousarray(ux), np.ascontiguousarray(uy)
+        ux, uy = to_global((0.0, 0.0, heading), unit, alpha)
         box = return_bounds(x, y, ux, uy, ranges, scan.range_min, scan.range_max)
         self._grow_to_box(*box, self.padding / 2)
         nx, ny = self.shape

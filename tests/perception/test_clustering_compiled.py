@@ -1,6 +1,8 @@
-"""The clustering's compiled passes (``_loops.window_beams``, ``run_bounds``,
-``run_shapes``, ``edge_ranges`` and ``edge_codes``, what ``cluster_scan`` calls) give, to
-the bit, the obstacle chain of the numpy code they replaced, field by field."""
+"""The clustering's compiled passes (``_loops.window_points``, ``run_bounds``,
+``run_shapes``, ``to_global_rows`` and ``edge_codes``, what ``cluster_scan`` calls) give,
+to the bit, the obstacle chain of the numpy code they replaced, field by field; that code
+calls the equation functions (Eqs. 1, 2, 3 and 6), so the equations inside the passes are
+checked against the pinned functions here."""
 
 from __future__ import annotations
 
@@ -132,6 +134,34 @@ PARAMS = [PerceptionParams(), PerceptionParams.paper(),
           PerceptionParams(min_beams=4, edge_inset=0.2, gap_floor=0.05, window_radius=3.0)]
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_the_equations_are_numpy_arithmetic_to_the_bit(seed: int) -> None:
+    """Eqs. 1, 2, 3 and 6, compiled once (``_equations.pxi``) behind ``to_global``,
+    ``grid_index``, ``join_threshold`` and ``box_area``, give what the same formulas give
+    in numpy, to the bit, in any shape (the chain test below builds on them)."""
+    rng = np.random.default_rng(900 + seed)
+    shape = [(), (7,), (3, 5)][seed % 3]
+    rho, alpha = rng.uniform(0.0, 9.0, shape), rng.uniform(-7.0, 7.0, shape)
+    x, y, th = (float(v) for v in rng.uniform(-30.0, 30.0, 3))
+    gx, gy = to_global((x, y, th), rho, alpha)
+    want_x, want_y = x + rho * np.cos(th + alpha), y + rho * np.sin(th + alpha)
+    assert (gx.shape, gx.tobytes(), gy.tobytes()) == (np.shape(want_x), np.asarray(
+        want_x).tobytes(), np.asarray(want_y).tobytes())
+    ux, _ = to_global((0.0, 0.0, th), 1.0, alpha)  # a scalar range broadcast, as the map does
+    assert ux.tobytes() == np.asarray(0.0 + 1.0 * np.cos(th + alpha)).tobytes()
+    coord = rng.uniform(-60.0, 60.0, shape)
+    assert grid_index(coord, 0.5).tobytes() == np.asarray(
+        np.floor(coord / 0.5 + 0.5).astype(np.int64)).tobytes()
+    params = PARAMS[seed % len(PARAMS)]
+    step = math.sin(abs(HALF_DEG))
+    assert join_threshold(rho, HALF_DEG, params).tobytes() == np.asarray(
+        params.lambda_ * rho * step + params.gap_floor).tobytes()
+    boxes = np.sort(rng.integers(-40, 40, (6, 2, 2)), axis=2).reshape(6, 4)
+    cells = (boxes[:, 1] - boxes[:, 0] + 1) * (boxes[:, 3] - boxes[:, 2] + 1)
+    assert box_area(boxes).tolist() == cells.tolist()
+    assert box_area(tuple(boxes[0].tolist())) == int(cells[0])
+
+
 @pytest.mark.parametrize("seed", range(30))
 def test_the_chain_is_the_numpy_one_to_the_bit(seed: int) -> None:
     rng = np.random.default_rng(seed)
@@ -146,7 +176,7 @@ def test_the_chain_is_the_numpy_one_to_the_bit(seed: int) -> None:
 
 @pytest.mark.parametrize("seed", range(20))
 def test_the_window_is_the_numpy_one_to_the_bit(seed: int) -> None:
-    """``scan_window`` (``_loops.window_beams``, then Eq. 1) against the numpy code it
+    """``scan_window`` (``_loops.window_points``, with Eq. 1) against the numpy code it
     replaced."""
     rng = np.random.default_rng(500 + seed)
     n = int(rng.choice([1, 3, 361, 720]))
@@ -159,8 +189,9 @@ def test_the_window_is_the_numpy_one_to_the_bit(seed: int) -> None:
     idx = np.flatnonzero(valid & (r <= radius))
     alpha = angle_min + idx * HALF_DEG
     px, py = to_global(pose, r[idx], alpha)
-    for a, b in zip((got.ranges, got.valid, got.beams, got.rho, got.alpha, got.x, got.y),
-                    (r, valid, idx, r[idx], alpha, px, py), strict=True):
+    points = np.column_stack((px, py))
+    for a, b in zip((got.ranges, got.valid, got.beams, got.rho, got.alpha, got.x, got.y,
+                     got.points), (r, valid, idx, r[idx], alpha, px, py, points), strict=True):
         assert (a.dtype, a.shape, a.tobytes()) == (b.dtype, b.shape, b.tobytes())
 
 
@@ -184,7 +215,7 @@ def test_every_edge_code_and_the_speck_filter_occur() -> None:
 
 def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
-    for name in ("window_beams", "run_bounds", "run_shapes", "edge_ranges",
+    for name in ("window_points", "run_bounds", "run_shapes", "to_global_rows",
                  "edge_codes"):
         real = getattr(_loops, name)
 
@@ -195,8 +226,8 @@ def test_production_calls_the_compiled_passes(monkeypatch: pytest.MonkeyPatch) -
         monkeypatch.setattr(_loops, name, counted)
     cluster_scan(np.array([2.0, 2.0, 2.0, 3.0]), 0.0, HALF_DEG, 0.05, 8.0, (0.0, 0.0, 0.0),
                  PerceptionParams())
-    assert sorted(calls) == ["edge_codes", "edge_ranges", "run_bounds", "run_shapes",
-                            "window_beams"]
+    assert sorted(calls) == ["edge_codes", "run_bounds", "run_shapes", "to_global_rows",
+                            "window_points"]
 
 
 @pytest.mark.parametrize("seed", range(5))

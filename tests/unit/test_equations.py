@@ -1,6 +1,11 @@
 """Each of the paper's equations (1-15, 17) pinned twice: to numbers worked by hand, and to
 the production path, which must call the very function pinned (a spy counts the calls; a
 copy of the equation inlined elsewhere would leave the count at zero and fail here).
+Where the production path is a compiled pass that computes an equation inside its loop
+(Eqs. 1, 2, 3 and 6 in perception's window, runs and edges, written once in
+``services/perception/_equations.pxi``, which the pinned functions call too; Eqs. 7-13
+in tracking's ``best_match``), a spy cannot count: the test checks instead that what the
+pass gives is, to the bit, what the pinned function gives for the same numbers.
 
 The production paths are the ones the services run: ``Perceiver.process`` (perception's
 node), ``Tracker.update`` (tracking's node) and ``Planner.step`` (the planner's node).
@@ -93,21 +98,37 @@ def test_eq1_by_hand() -> None:
     assert np.allclose(x, [1.0, 3.0]) and np.allclose(y, [4.0, 2.0])
 
 
-def test_eq1_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
-    spy = Spy(monkeypatch, clustering, "to_global")
-    perceive([2.0, 2.0, 2.0])
-    assert spy.calls >= 2  # the points, then the Eq. 5 centres
+POSE = (1.25, -0.75, 2.0)  # a pose where every term of Eq. 1 counts
 
 
-def test_eq1_is_what_the_motion_cue_calls(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_eq1_is_what_perception_computes() -> None:
+    """The window's points (each cluster's first and last) and the Eq. 5 centres are
+    Eq. 1 of their ranges and angles, to the bit."""
+    ranges = [2.0, 2.0, 2.0, math.inf, 3.1, 3.1, 3.1]
+    c = perceive(ranges, pose=POSE)
+    assert len(c) == 2
+    cx, cy = clustering.to_global(POSE, c.mean_rho, c.mean_alpha)
+    assert c.centre.tobytes() == np.column_stack((cx, cy)).tobytes()
+    beams = c.beams.reshape(-1)
+    rho = np.asarray(ranges, dtype=np.float32).astype(np.float64)  # as on the wire
+    px, py = clustering.to_global(POSE, rho[beams], beams * HALF_DEG)
+    ends = np.column_stack((px, py)).reshape(-1, 2, 2)
+    assert c.first_point.tobytes() == ends[:, 0].copy().tobytes()
+    assert c.last_point.tobytes() == ends[:, 1].copy().tobytes()
+
+
+def test_eq1_is_what_the_motion_cue_uses(monkeypatch: pytest.MonkeyPatch) -> None:
     """The free-space motion test puts each scan's points in the global frame by Eq. 1
     too: perception hands it the window's points the clustering made global
-    (``scan_window``), one Eq. 1 pass for both."""
-    spy = Spy(monkeypatch, clustering, "to_global")
+    (``scan_window``), one Eq. 1 pass for both; the cue makes none of its own."""
     own = Spy(monkeypatch, motion_cue, "to_global")
-    perceive([2.0, 2.0, 2.0])
-    assert spy.calls == 2  # the window's points for both, then the Eq. 5 centres
+    perceiver = Perceiver(PAPER)
+    ranges = [2.0, 2.0, 2.0]
+    perceive(ranges, pose=POSE, perceiver=perceiver)
     assert own.calls == 0
+    _, _, kept = perceiver.cue._scans[-1]
+    px, py = clustering.to_global(POSE, ranges, np.arange(3) * HALF_DEG)
+    assert kept.tobytes() == np.column_stack((px, py)).tobytes()
 
 
 def test_the_motion_cue_points_are_eq1() -> None:
@@ -179,12 +200,20 @@ def test_eq2_by_hand() -> None:
     assert clustering.grid_index([0.24, 0.26, -0.26, 1.74], 0.5).tolist() == [0, 1, -1, 3]
 
 
-def test_eq2_is_what_perception_and_morphin_call(monkeypatch: pytest.MonkeyPatch) -> None:
-    in_perception = Spy(monkeypatch, clustering, "grid_index")
+def test_eq2_is_what_perception_computes() -> None:
+    """Each cluster's grid box is Eq. 2 of the least and greatest x and y of its points
+    (no edge inset), to the bit."""
+    c = perceive([2.0, 2.0, 2.0, 2.0, 2.0], pose=POSE)
+    assert len(c) == 1
+    px, py = clustering.to_global(POSE, [2.0] * 5, np.arange(5) * HALF_DEG)
+    want = clustering.grid_index([px.min(), px.max(), py.min(), py.max()], PAPER.cell)
+    assert c.box[0].tolist() == want.tolist()
+
+
+def test_eq2_is_what_morphin_calls(monkeypatch: pytest.MonkeyPatch) -> None:
     in_morphin = Spy(monkeypatch, morphin, "grid_index")
-    perceive([2.0, 2.0, 2.0])
     plan_round_a_box()
-    assert in_perception.calls >= 1 and in_morphin.calls >= 1
+    assert in_morphin.calls >= 1
 
 
 # --- Eq. 3 --------------------------------------------------------------------------
@@ -199,17 +228,16 @@ def test_eq3_by_hand() -> None:
                                                                                      abs=1e-7)
 
 
-def test_eq3_is_what_perception_calls(monkeypatch: pytest.MonkeyPatch) -> None:
-    spy = Spy(monkeypatch, clustering, "join_threshold")
-    perceive([2.0, 2.0, 2.0])
-    assert spy.calls >= 1
-
-
-def test_eq3_decides_the_breaks(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A threshold of zero everywhere splits every beam: the one function decides."""
-    monkeypatch.setattr(clustering, "join_threshold",
-                        lambda rho, inc, params: np.zeros_like(np.asarray(rho, dtype=float)))
-    assert len(perceive([2.0, 2.0, 2.0])) == 3
+def test_eq3_decides_the_breaks() -> None:
+    """Neighbouring points at 2 m lie 2 * 2 m * sin(0.25 deg) = 0.017453 m apart: under
+    Eq. 3's threshold with the paper's lambda 1.2 (0.020944 m), one cluster; over it
+    with lambda 0.9 (0.015708 m), a cluster per beam."""
+    chord = 2 * 2.0 * math.sin(HALF_DEG / 2)
+    wide, narrow = PAPER, PAPER.model_copy(update={"lambda_": 0.9})
+    assert (float(clustering.join_threshold(2.0, HALF_DEG, narrow)) < chord
+            < float(clustering.join_threshold(2.0, HALF_DEG, wide)))
+    assert len(perceive([2.0, 2.0, 2.0], params=wide)) == 1
+    assert len(perceive([2.0, 2.0, 2.0], params=narrow)) == 3
 
 
 # --- Eq. 4 and Eq. 5: a worked obstacle chain ------------------------------------------
@@ -266,11 +294,14 @@ def test_eq6_by_hand() -> None:
     assert clustering.box_area([[2, 4, 1, 1], [0, 1, 0, 2]]).tolist() == [3, 6]
 
 
-def test_eq6_is_what_perception_and_tracking_call(monkeypatch: pytest.MonkeyPatch) -> None:
-    in_perception = Spy(monkeypatch, clustering, "box_area")
+def test_eq6_is_what_perception_computes_and_tracking_calls(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    c = perceive([2.0, 2.0, math.inf, 1.0, 1.0, 1.0, 1.0], pose=POSE)
+    assert len(c) == 2
+    assert c.area.tolist() == clustering.box_area(c.box).tolist()
     in_correlation = Spy(monkeypatch, correlation, "box_area")
     track_two_frames()
-    assert in_perception.calls >= 1 and in_correlation.calls >= 1
+    assert in_correlation.calls >= 1
 
 
 # --- Eqs. 7-13 ------------------------------------------------------------------------
