@@ -22,7 +22,8 @@ import numpy as np
 
 cimport cython
 from libc.math cimport INFINITY, cos, fma, hypot, isnan, sin, sqrt
-from libc.string cimport memcmp, memset
+from libc.stdint cimport uint64_t
+from libc.string cimport memcmp, memcpy, memset
 
 include "../_angles.pxi"
 
@@ -342,6 +343,17 @@ def look_up_rows(const double[:, ::1] xs, const double[:, ::1] ys, double ox, do
                 break
 
 
+cdef inline unsigned char lethal_at(Py_ssize_t c, const unsigned char[::1] occupied,
+                                   const double[::1] seen, const double[::1] hit_since,
+                                   const unsigned char[::1] walls, double known_from,
+                                   double confirmed_by, double wall_known_from,
+                                   double wall_confirm) noexcept nogil:
+    """Whether cell ``c`` is lethal (:func:`lethal_cells`)."""
+    return ((occupied[c] != 0) & (seen[c] >= known_from) & (hit_since[c] <= confirmed_by)
+            | (walls[c] != 0) & (seen[c] >= wall_known_from)
+            & (seen[c] - hit_since[c] >= wall_confirm))
+
+
 def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
                  const double[::1] hit_since, const unsigned char[::1] walls,
                  double known_from, double confirmed_by, double wall_known_from,
@@ -352,17 +364,24 @@ def lethal_cells(const unsigned char[::1] occupied, const double[::1] seen,
     ``confirmed_by`` or earlier; or a wall seen at ``wall_known_from`` or later (the
     same comparisons: a nan is neither); whether they differ from ``before`` (a grid of
     the same size, the last lethal cells). Most cells are neither occupied nor a wall:
-    their times are not read."""
-    cdef Py_ssize_t c, n = occupied.shape[0]
+    eight at a time are passed over when none of them is, and their times are not
+    read."""
+    cdef Py_ssize_t c = 0, k, n = occupied.shape[0]
+    cdef uint64_t occupied8, walls8
     if n == 0:
         return False
     memset(&out[0], 0, n)
-    for c in range(n):
-        if occupied[c] | walls[c]:
-            out[c] = ((occupied[c] != 0) & (seen[c] >= known_from)
-                      & (hit_since[c] <= confirmed_by)
-                      | (walls[c] != 0) & (seen[c] >= wall_known_from)
-                      & (seen[c] - hit_since[c] >= wall_confirm))
+    while c + 8 <= n:
+        memcpy(&occupied8, &occupied[c], 8)
+        memcpy(&walls8, &walls[c], 8)
+        if occupied8 | walls8:
+            for k in range(c, c + 8):
+                out[k] = lethal_at(k, occupied, seen, hit_since, walls, known_from,
+                                   confirmed_by, wall_known_from, wall_confirm)
+        c += 8
+    for k in range(c, n):
+        out[k] = lethal_at(k, occupied, seen, hit_since, walls, known_from, confirmed_by,
+                           wall_known_from, wall_confirm)
     return memcmp(&out[0], &before[0], n) != 0
 
 

@@ -326,10 +326,13 @@ def test_the_compiled_lethal_cells_are_lethals(seed: int) -> None:
     """The lethal grid ``_refresh`` makes in one compiled pass (``_loops.lethal_cells``,
     what ``lethal_grid`` and the inflation read) against ``lethal()``, the numpy test:
     cells seen and hit at random times, walls among them, on the decay, wall decay and
-    confirmation edges exactly, never seen (-inf), nan; and the cache kept only while
-    the set stays the same."""
+    confirmation edges exactly, never seen (-inf), nan, on grids dense and sparse (the
+    pass skips eight empty cells at a time); and the cache kept only while the set
+    stays the same."""
     rng = np.random.default_rng(seed)
-    cm = Costmap((0.0, 0.0), (4.0, 3.0), resolution=0.1, decay=2.0, inflation=0.3,
+    # 60 x 50 cells, or 63 x 49: a last run shorter than eight
+    goal = (4.0, 3.0) if seed % 2 else (4.3, 2.9)
+    cm = Costmap((0.0, 0.0), goal, resolution=0.1, decay=2.0, inflation=0.3,
                  confirm=0.5, wall_decay=5.0, wall_confirm=1.0, padding=1.0,
                  max_size=30.0)
     kept = renewed = 0
@@ -337,8 +340,10 @@ def test_the_compiled_lethal_cells_are_lethals(seed: int) -> None:
     for k in range(30):
         cm.now = 10.0 + 0.1 * k
         if rng.random() < 0.7:  # else the grids stay and only the time moves on
-            cm.occupied = rng.random(cm.shape) < 0.3
-            cm.walls = rng.random(cm.shape) < 0.3
+            # dense, or sparse enough that most runs of eight cells hold neither
+            density = 0.3 if k % 2 else 0.01
+            cm.occupied = rng.random(cm.shape) < density
+            cm.walls = rng.random(cm.shape) < density
             cm.seen = rng.choice([cm.now - 2.0, cm.now - 1.0, cm.now - 3.0, cm.now - 5.0,
                                   cm.now - 6.0, -math.inf, math.nan, cm.now], size=cm.shape)
             cm.hit_since = rng.choice([cm.now - 0.5, cm.now - 0.4, cm.now, math.inf,
