@@ -85,6 +85,15 @@ class ScanData:
     range_max: float  # m
     range_min: float = 0.0
 
+    def returns(self) -> npt.NDArray[np.float64]:
+        """(n, 2) global points of the beams that returned (``range_min`` <= range <
+        ``range_max``), by Eq. 1 (``to_global``)."""
+        beams = np.flatnonzero((self.ranges >= self.range_min)
+                               & (self.ranges < self.range_max))
+        x, y = to_global(self.pose, self.ranges[beams],
+                         self.angle_min + self.angle_increment * beams)
+        return np.column_stack((x, y))
+
 
 G = TypeVar("G", bound=np.generic)
 

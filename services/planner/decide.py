@@ -34,11 +34,17 @@ import numpy.typing as npt
 
 from zenav.schemas.messages import Action, ObstacleKind, ScenarioLetter
 from zenav.services.geometry import disc_distance, wrap_angle
+from zenav.services.motor_bridge.stop_zone import stop_distance
 from zenav.services.planner import safety
 from zenav.services.planner._loops import box_gaps, c_hypot
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
-from zenav.services.planner.follow import backing_toward, command_toward
+from zenav.services.planner.follow import (
+    backing_toward,
+    command_toward,
+    reach_along,
+    room_near,
+)
 from zenav.services.planner.give_way import (
     Hold,
     corridor_axis,
@@ -89,6 +95,13 @@ wall with the comfortable clearance (``Planner.settle_goal``): the rest of the
 tolerance is the arrival's own room."""
 SETTLE_REACH_CLOSE = 0.9
 """The same with the close clearance, the last resort before driving at the goal."""
+
+NO_ROOM = "no room at the goal for the robot and its stop zone"
+"""Why the goal is unreachable when ``Planner.look_for_room`` finds none."""
+
+NO_ROOM_LOOK = 1.0
+"""m beyond the goal's tolerance: no room at the goal starts the recovery steps, one
+after another, once the robot is this near (it has looked from close by)."""
 
 
 @dataclass(frozen=True)
@@ -184,6 +197,7 @@ class Planner:
             backup_speed=params.backup_speed, wait_time=params.wait_time,
             max_rounds=params.recovery_rounds))
         self.walled = False  # the goal cut off by the wall memory (``walled_in``)
+        self.no_room = False  # no room at the goal, when last looked at (``look_for_room``)
         self.walled_stamp = -math.inf
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0  # the speed last commanded, m/s
@@ -394,15 +408,83 @@ class Planner:
             path_count(length - first, self.p.map_resolution / 2))
 
     def _threats(self, notes: list[Assessment], clear: bool, stamp: float, robot: Vec,
-                 target: Vec, to_goal: bool) -> list[Assessment]:
+                 target: Vec, to_goal: bool, last_stretch: bool = False) -> list[Assessment]:
         """The assessments to answer: threats of a known type, confirmed, and not a (b)
         while the map finds the way to ``target`` clear (``clear``) on an obstacle the
-        map holds, or on one too young for the map whose returns all keep off the way."""
+        map holds, or on one too young for the map whose returns all keep off the way;
+        no (b) at all on the ``last_stretch`` to a goal beside what the laser sees."""
         return [self._sticky(a) for a in notes
                 if a.threat and a.obstacle.kind != "new" and not self._unconfirmed(a, stamp)
+                and not (a.letter == "b" and last_stretch)
                 and not (a.letter == "b" and clear
                          and (self._mapped(a, stamp)
                               or self._returns_off_the_way(a, robot, target, to_goal)))]
+
+    def last_stretch(self, robot: Vec, heading: float, scan: ScanData | None) -> bool:
+        """Beyond the paper (``final_approach_speed``): whether the robot is on the last
+        stretch to a goal that lies beside what the laser sees (the goal is not clear by
+        the robot's radius plus half ``safety_margin`` on the map, as for
+        ``settle_goal``): the goal within the window and the laser's field of view, and
+        the straight way to the goal (as settled) keeps ``_approach_clearance`` off every
+        return of the scan as far as a point within the tolerance of the run's goal
+        (``follow.reach_along``). The (b) test's 0.5 m cell box S_k of a wall close
+        to the goal covers the goal, and the detours round the wall never reach it; the
+        scan's returns lie where the wall is, to the centimetre."""
+        if not self._beside_in_view(robot, heading, scan):
+            return False
+        assert scan is not None
+        return self._stops_within_tolerance(robot, scan)
+
+    def _beside_in_view(self, robot: Vec, heading: float, scan: ScanData | None) -> bool:
+        """The final approach is on, the goal is within the window and the laser's field
+        of view, and the map holds something within the robot's radius plus half
+        ``safety_margin`` of it (``settle_goal``'s test)."""
+        p = self.p
+        if (p.final_approach_speed <= 0.0 or scan is None or self.costmap is None
+                or not p.use_map):
+            return False
+        offset = self.mission_goal - robot
+        if c_hypot(*offset) > p.window_radius:
+            return False
+        if goal_clear(self.costmap, self.mission_goal, p.robot_radius + p.safety_margin / 2):
+            return False  # a goal in the open: the paper's tests decide
+        bearing = wrap_angle(math.atan2(offset[1], offset[0]) - heading)
+        angle_max = scan.angle_min + scan.angle_increment * (scan.ranges.shape[0] - 1)
+        return bool(scan.angle_min <= bearing <= angle_max)
+
+    def _arrived_beside(self, robot: Vec, heading: float, scan: ScanData | None) -> bool:
+        """On the last stretch (``last_stretch``) and within the run's tolerance of its
+        goal (a hundredth of it to spare), with no nearer point to be had: the centre can
+        go no farther along the straight way to the goal keeping ``_approach_clearance``
+        off the scan's returns."""
+        p = self.p
+        if (scan is None or self.costmap is None
+                or c_hypot(*(self.mission_goal - robot)) >= 0.99 * p.goal_tolerance
+                or not self.last_stretch(robot, heading, scan)):
+            return False
+        start = (float(robot[0]), float(robot[1]))
+        end = (float(self.goal[0]), float(self.goal[1]))
+        return reach_along(start, end, scan.returns(), self._approach_clearance()) < 1e-3
+
+    def _approach_clearance(self) -> float:
+        """How near the returns the last stretch takes the robot's centre: its radius
+        plus the stop zone's reach at ``final_approach_speed``, as near as the bridge
+        lets a robot at that speed come head-on."""
+        p = self.p
+        return p.robot_radius + stop_distance(p.final_approach_speed, p.zone_reaction,
+                                              p.decel, p.zone_margin)
+
+    def _stops_within_tolerance(self, robot: Vec, scan: ScanData) -> bool:
+        """Whether driving straight for the goal (as settled), the robot's centre keeping
+        ``_approach_clearance`` off the scan's returns, ends within the run's tolerance
+        of its goal (a hundredth of it to spare)."""
+        p = self.p
+        end = (float(self.goal[0]), float(self.goal[1]))
+        start = (float(robot[0]), float(robot[1]))
+        length = math.dist(start, end)
+        reach = reach_along(start, end, scan.returns(), self._approach_clearance())
+        stop = robot if length < 1e-12 else robot + (self.goal - robot) * (reach / length)
+        return c_hypot(*(stop - self.mission_goal)) < 0.99 * p.goal_tolerance
 
     def _returns_off_the_way(self, a: Assessment, robot: Vec, target: Vec,
                              to_goal: bool) -> bool:
@@ -763,7 +845,8 @@ class Planner:
     # -- the cycle ---------------------------------------------------------------------
 
     def local_layer(
-        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float
+        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float,
+        scan: ScanData | None = None,
     ) -> Decision:
         """The paper's local layer toward the look-ahead point on the global path:
         assess every obstacle in the window, respond per scenario letter, plan a Morphin
@@ -772,12 +855,14 @@ class Planner:
         robot = np.array(pose[:2], dtype=np.float64)
         in_window = [o for o in obstacles if self._in_window(o, pose)]
         path_target = self.path_target(robot, self._statics(in_window))
+        last_stretch = self.last_stretch(robot, pose[2], scan)
 
         if self.detour is not None:
             reached = c_hypot(*(self.detour.subtarget - robot)) < p.subtarget_reached
             direct = self._assess_all(robot, path_target, in_window, p.resume_hysteresis,
                                       to_goal=True)
-            if reached or not any(a.threat and a.letter in "bf" for a in direct):
+            if (reached or last_stretch
+                    or not any(a.threat and a.letter in "bf" for a in direct)):
                 self.detour = None
                 # The way back is judged on a path from here: the cycle's own check ran
                 # while the detour was under way, and the old path's rejoin point can lie
@@ -797,14 +882,15 @@ class Planner:
         # The map may clear the way to the target (the path's look-ahead point, or the
         # detour's sub-target); whether a detour may end is still the boxes' call.
         clear = self._map_clear(robot, target, to_goal=self.detour is None)
-        threats = self._threats(notes, clear, stamp, robot, target, self.detour is None)
+        threats = self._threats(notes, clear, stamp, robot, target, self.detour is None,
+                                last_stretch)
         if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
                                                              in_window, stamp):
             # The path now goes round what the map holds: judge the way along it again.
             path_target = target = self.path_target(robot, self._statics(in_window))
             notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
             clear = self._map_clear(robot, target, to_goal=True)
-            threats = self._threats(notes, clear, stamp, robot, target, True)
+            threats = self._threats(notes, clear, stamp, robot, target, True, last_stretch)
         # A crosser the robot gives way to stays answered until it has crossed the
         # robot's way, not only while the prediction (noisy) still says they would meet.
         found = {a.obstacle.id: a for a in notes}
@@ -993,7 +1079,8 @@ class Planner:
             self._set_path(np.vstack([self.start, self.goal]), "start")
         self._remember_trail(robot)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        if c_hypot(*(self.goal - robot)) <= self.arrival_radius():
+        if (c_hypot(*(self.goal - robot)) <= self.arrival_radius()
+                or self._arrived_beside(robot, pose[2], scan)):
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
         if self.recovery.unreachable:
@@ -1004,6 +1091,7 @@ class Planner:
         # graze them, and a radius a little short would leave marks in a mover's wake).
         self.update_map(pose, tracked, scan, stamp)
         self.settle_goal(robot)
+        self.look_for_room(robot, pose[2], scan)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
         if (decision is not None and decision.action in YIELDING
@@ -1020,7 +1108,7 @@ class Planner:
                 # too late for a better one): the hold ends and the local layer answers.
                 self.hold = None
                 decision = None
-            decision = decision or self.local_layer(pose, obstacles, stamp)
+            decision = decision or self.local_layer(pose, obstacles, stamp, scan)
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(self.brake_for_goal(decision, pose, scan),
@@ -1036,10 +1124,18 @@ class Planner:
             # along a path through forgotten walls are no progress: the steps follow one
             # another at once instead of after a stall (and progress does not reset them).
             walled = p.recovery and self.walled_in(robot, stamp)
-            if p.recovery and (walled or self.recovery.watch(
+            # No room at the goal, and the robot near enough to have looked: the same.
+            cramped = p.recovery and self.no_room and c_hypot(
+                *(self.mission_goal - robot)) <= p.goal_tolerance + NO_ROOM_LOOK
+            if p.recovery and (walled or cramped or self.recovery.watch(
                     stamp, self.to_go(robot), waiting, decision.refused)):
-                way = (self.plan is None or self.plan.found) and not walled
-                step = self.recovery.start_next(stamp, pose, way_known=way)
+                way = (self.plan is None or self.plan.found) and not walled and not cramped
+                if cramped and self.recovery.level >= len(STEPS):
+                    # A round of the steps has looked again, and there is still no room.
+                    self.recovery.give_up()
+                    step = None
+                else:
+                    step = self.recovery.start_next(stamp, pose, way_known=way)
                 if step is None:
                     self._walled_off()
                     decision = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
@@ -1611,6 +1707,30 @@ class Planner:
         the path published is empty, not the one through the forgotten walls."""
         if self.walled and (self.plan is None or self.plan.found):
             self.plan = GlobalPlan(np.empty((0, 2)), math.inf, "the walls seen close it off")
+        elif self.no_room and (self.plan is None or self.plan.found):
+            self.plan = GlobalPlan(np.empty((0, 2)), math.inf, NO_ROOM)
+
+    def look_for_room(self, robot: Vec, heading: float, scan: ScanData | None) -> None:
+        """Beyond the paper (``final_approach_speed``), once a scan: when the goal lies
+        beside what the laser sees (within the window and its view, not clear on the map,
+        as for ``last_stretch``), whether no point within the run's tolerance of it
+        keeps ``_approach_clearance`` off the scan's returns
+        (``follow.room_near``): no robot the stop zone lets come that near a return
+        stands within the tolerance. Kept in ``no_room`` until the goal is seen again
+        (recovery gives the goal up on it, after a round of steps); a goal in the open
+        has room."""
+        p = self.p
+        if self.costmap is None or c_hypot(*(self.mission_goal - robot)) > p.window_radius:
+            return
+        if not self._beside_in_view(robot, heading, scan):
+            if goal_clear(self.costmap, self.mission_goal,
+                          p.robot_radius + p.safety_margin / 2):
+                self.no_room = False
+            return
+        assert scan is not None
+        self.no_room = not room_near((float(self.mission_goal[0]), float(self.mission_goal[1])),
+                                     scan.returns(), self._approach_clearance(),
+                                     p.goal_tolerance)
 
     def recover(self, pose: tuple[float, float, float], stamp: float,
                 scan: ScanData | None) -> Decision | None:
@@ -1621,7 +1741,7 @@ class Planner:
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
         if r.active is None and r.level >= len(STEPS) and (
                 (self.plan is not None and not self.plan.found)
-                or self.walled_in(robot, stamp, fresh=True)):
+                or self.walled_in(robot, stamp, fresh=True) or self.no_room):
             # Every recovery step tried and still no way on the map: give up, clearly.
             r.unreachable = True
             self._walled_off()
@@ -1706,6 +1826,25 @@ class Planner:
         return math.dist((float(point[0]), float(point[1])),
                          (float(self.goal[0]), float(self.goal[1]))) <= 1e-9
 
+    def _creep_to_goal(self, d: Decision, pose: tuple[float, float, float],
+                       ranges: npt.NDArray[np.float32], scan: ScanData) -> Decision | None:
+        """``final_approach_speed``: the decision at that speed when the robot heads for
+        the goal (as settled), the goal lies within the zone's reach at the speed asked
+        (what refuses the motion may stand beyond it: a wall behind a goal close to it),
+        and the zone at the creep holds no return; None otherwise. The zone is shortest
+        at a creep: the robot comes as near as the bridge lets any robot come."""
+        p = self.p
+        creep = p.final_approach_speed
+        if creep <= 0.0 or creep >= d.v or not self._is_goal(d.target):
+            return None
+        reach = p.robot_radius + stop_distance(d.v, p.zone_reaction, p.decel, p.zone_margin)
+        if math.dist(pose[:2], (float(d.target[0]), float(d.target[1]))) > reach:
+            return None
+        if p.blocks(ranges, scan.angle_min, scan.angle_increment, scan.range_max,
+                    max(creep, self.last_v), p.robot_radius):
+            return None
+        return dataclasses.replace(d, v=creep)
+
     def guard_stop_zone(self, d: Decision, pose: tuple[float, float, float],
                         scan: ScanData | None) -> Decision:
         """Never command forward motion into the motor bridge's stop zone (the same
@@ -1718,6 +1857,9 @@ class Planner:
         if not p.blocks(ranges, scan.angle_min, scan.angle_increment, scan.range_max,
                         max(d.v, self.last_v), p.robot_radius):
             return d
+        creep = self._creep_to_goal(d, pose, ranges, scan)
+        if creep is not None:
+            return creep
         error = math.atan2(d.target[1] - pose[1], d.target[0] - pose[0]) - pose[2]
         error = wrap_angle(error)
         turns = sorted((math.radians(g) for g in range(-90, 91, 10)),

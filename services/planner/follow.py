@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import numpy.typing as npt
+
 from zenav.services.geometry import wrap_angle
 
 
@@ -51,3 +54,44 @@ def backing_toward(
     toward it as ``command_toward`` turns the front, v negative."""
     v, omega = command_toward(x, y, heading + math.pi, target, speed, heading_gain, max_omega)
     return -v, omega
+
+
+def reach_along(start: tuple[float, float], end: tuple[float, float],
+                points: npt.NDArray[np.float64], clearance: float) -> float:
+    """How far (m) a disc centre can go from ``start`` straight toward ``end``, at most
+    to ``end``, keeping ``clearance`` from every point of ``points`` (n, 2): 0 when one
+    is nearer than that already. A point ``along`` the way and ``aside`` off it is met
+    at ``along - sqrt(clearance^2 - aside^2)``; points behind the start or farther
+    aside are never met."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    length = math.hypot(dx, dy)
+    if length < 1e-12:
+        return 0.0
+    ux, uy = dx / length, dy / length
+    qx, qy = points[:, 0] - start[0], points[:, 1] - start[1]
+    along = qx * ux + qy * uy
+    aside = qx * uy - qy * ux
+    half = np.sqrt(np.maximum(clearance * clearance - aside * aside, 0.0))
+    met = (np.abs(aside) < clearance) & (along + half > 0.0)
+    if not met.any():
+        return length
+    return float(min(max(float((along[met] - half[met]).min()), 0.0), length))
+
+
+def room_near(goal: tuple[float, float], points: npt.NDArray[np.float64], clearance: float,
+              reach: float, step: float = 0.01) -> bool:
+    """Whether some point within ``reach`` of ``goal`` keeps ``clearance`` from every
+    point of ``points`` (n, 2): the goal itself, or one on the rings round it at most
+    ``step`` apart out to ``reach`` itself, each sampled every ``step`` along it (a room
+    thinner than a step can be missed: no robot stops that precisely)."""
+    gx, gy = goal
+    near = points[np.hypot(points[:, 0] - gx, points[:, 1] - gy) < reach + clearance]
+    if near.shape[0] == 0:
+        return True
+    radii = np.linspace(0.0, reach, max(math.ceil(reach / step), 1) + 1)
+    counts = np.maximum(np.ceil(2.0 * math.pi * radii / step), 1).astype(np.int64)
+    ring = np.repeat(radii, counts)
+    turn = np.concatenate([np.arange(k) / k for k in counts.tolist()]) * 2.0 * math.pi
+    cx, cy = gx + ring * np.cos(turn), gy + ring * np.sin(turn)
+    gaps = np.hypot(cx[:, None] - near[None, :, 0], cy[:, None] - near[None, :, 1])
+    return bool((gaps.min(axis=1) >= clearance).any())

@@ -126,6 +126,12 @@ class Recovery:
         self.refused_since = None
         return step
 
+    def give_up(self) -> None:
+        """The goal is unreachable, whatever the rounds: the caller knows it (no room at
+        the goal once a round of the steps has looked again)."""
+        self.unreachable = True
+        self.active = None
+
     def finish(self, stamp: float, to_go: float) -> None:
         """The active step is over: navigation is tried again with a fresh window."""
         self.active = None

@@ -144,3 +144,17 @@ def test_returns_not_yet_confirmed_are_found_near_a_segment() -> None:
     assert cm.returns_near_segment(a, np.array([3.1, 0.8]), 0.35)  # into it
     assert not cm.returns_near_segment(a, np.array([3.1, 0.8]), 0.35,
                                        np.array([0.0, -1.0]), np.array([1.0, 0.0]))
+
+
+def test_a_scan_s_returns_are_where_its_beams_met_something_in_the_global_frame() -> None:
+    pose = (1.0, 2.0, math.pi / 2)  # facing +y
+    scan = scan_of(pose, boxes=[(0.0, 4.0, 2.0, 4.2)], range_max=8.0)
+    points = scan.returns()
+    hits = int(np.count_nonzero(scan.ranges < scan.range_max))
+    assert 0 < hits < scan.ranges.shape[0] and points.shape == (hits, 2)
+    assert np.allclose(points[:, 1], 4.0, atol=1e-9)  # on the wall's near face
+    assert points[:, 0].min() >= -1e-9 and points[:, 0].max() <= 2.0 + 1e-9
+    # The beam straight ahead returns at (1, 4).
+    ahead = scan.ranges.shape[0] // 2
+    before = int(np.count_nonzero(scan.ranges[:ahead] < scan.range_max))
+    assert np.allclose(points[before], (1.0, 4.0))

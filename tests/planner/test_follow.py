@@ -1,13 +1,15 @@
 """Driving toward a point (``follow.py``): the turn, the slowing near the target, and
-braking for it at a given rate."""
+braking for it at a given rate; how far a disc goes straight before it comes too near a
+point, and whether there is room near a goal."""
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
-from zenav.services.planner.follow import backing_toward, command_toward
+from zenav.services.planner.follow import backing_toward, command_toward, reach_along, room_near
 
 
 def test_straight_ahead_far_off_drives_at_the_speed_asked_without_turning() -> None:
@@ -55,3 +57,50 @@ def test_the_speed_falls_to_the_distance_covered_in_the_time_given() -> None:
     assert v == pytest.approx(0.6)
     v, _ = command_toward(0.0, 0.0, 0.0, (1.0, 0.0), 1.5, 2.0, 1.0, within=1.0 / 1.5)
     assert v == pytest.approx(1.5)
+
+
+def wall(y: float, x0: float = -2.0, x1: float = 2.0, step: float = 0.01) -> np.ndarray:
+    """Points every ``step`` along the line at ``y`` from ``x0`` to ``x1``."""
+    xs = np.arange(x0, x1 + 1e-9, step)
+    return np.column_stack((xs, np.full(xs.shape, y)))
+
+
+def test_a_disc_goes_all_the_way_when_nothing_is_near_it() -> None:
+    assert reach_along((0.0, 0.0), (0.0, 2.0), np.empty((0, 2)), 0.3) == pytest.approx(2.0)
+    beside = np.array([[0.31, 1.0], [-0.5, 0.5]])  # farther aside than the clearance
+    assert reach_along((0.0, 0.0), (0.0, 2.0), beside, 0.3) == pytest.approx(2.0)
+    behind = np.array([[0.0, -0.31]])
+    assert reach_along((0.0, 0.0), (0.0, 2.0), behind, 0.3) == pytest.approx(2.0)
+
+
+def test_a_wall_ahead_stops_the_disc_the_clearance_short_of_it() -> None:
+    assert reach_along((0.0, 0.0), (0.0, 3.0), wall(1.5), 0.3) == pytest.approx(1.2)
+    # The end comes first when the wall lies beyond it.
+    assert reach_along((0.0, 0.0), (0.0, 1.0), wall(1.5), 0.3) == pytest.approx(1.0)
+
+
+def test_a_point_aside_stops_the_disc_where_its_edge_first_meets_it() -> None:
+    # 0.18 m aside with 0.3 m clearance: met 0.24 m before the point along the way.
+    reach = reach_along((0.0, 0.0), (2.0, 0.0), np.array([[1.0, 0.18]]), 0.3)
+    assert reach == pytest.approx(1.0 - math.sqrt(0.3**2 - 0.18**2))
+
+
+def test_a_disc_already_too_near_a_point_goes_nowhere() -> None:
+    assert reach_along((0.0, 0.0), (0.0, 2.0), np.array([[0.1, -0.1]]), 0.3) == 0.0
+
+
+def test_room_near_a_goal_by_a_wall_is_on_the_far_side_of_it_or_nowhere() -> None:
+    points = wall(0.5)
+    # 0.3 m clearance within 0.25 m of the goal: the goal must lie at least 0.05 m off.
+    assert room_near((0.0, 0.47), points, 0.3, 0.25) is False
+    assert room_near((0.0, 0.44), points, 0.3, 0.25) is True
+    assert room_near((0.0, 0.6), points, 0.3, 0.25) is True  # and on the far side
+    assert room_near((0.0, -1.0), points, 0.3, 0.25) is True  # the goal itself is clear
+    assert room_near((0.0, 0.0), np.empty((0, 2)), 0.3, 0.25) is True
+
+
+def test_the_room_at_the_tolerance_s_very_edge_counts() -> None:
+    # Only the ring at the reach itself, straight down from the goal, is clear.
+    goal_y = 0.5 - (0.3 - 0.25) - 0.002  # 0.052 m below the wall
+    assert room_near((0.0, goal_y), wall(0.5), 0.3, 0.25) is True
+    assert room_near((0.0, goal_y + 0.004), wall(0.5), 0.3, 0.25) is False

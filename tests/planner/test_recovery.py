@@ -74,3 +74,11 @@ def test_while_a_way_is_known_the_rounds_go_on() -> None:
         r.finish(float(k), 5.0)
     assert steps == ["replan", "spin", "back_up", "wait"] * 3
     assert not r.unreachable
+
+
+def test_giving_up_ends_the_step_under_way_and_marks_the_goal_unreachable() -> None:
+    r = Recovery(SETTINGS)
+    assert r.start_next(0.0, (0.0, 0.0, 0.0)) == "replan"
+    assert r.active is not None and not r.unreachable
+    r.give_up()
+    assert r.active is None and r.unreachable

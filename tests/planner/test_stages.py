@@ -14,7 +14,7 @@ import pytest
 from tests.planner.scans import scan_of
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
-from zenav.services.planner.decide import SPEED_GAP, Decision, Detour, Planner
+from zenav.services.planner.decide import NO_ROOM, SPEED_GAP, Decision, Detour, Planner
 from zenav.services.planner.global_path import point_at, project
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
@@ -601,6 +601,105 @@ def test_a_path_the_stop_zone_refuses_where_the_map_blocks_it_is_planned_again()
     assert p.plan is not None and p.plan.found and p.plan.reason == "blocked within the window"
     assert p.costmap is not None and p.path is not None
     assert not p.costmap.blocked_at(p.path[1:], outside=True).any()
+
+
+# -- the last stretch to a goal beside a wall (final_approach_speed) ----------------------
+# The goal (8, 3) lies ``gap`` m short of a wall's face; the robot's radius is 0.2 m and
+# the run's tolerance 0.25 m, so its centre can come within it while the stop zone at a
+# creep (0.08 m + 0.05 m/s x 0.3 s + ...: 0.096 m beyond the front) lets it on, down to
+# a gap of 0.04 m.
+
+
+def wall_beyond_goal(gap: float) -> list[tuple[float, float, float, float]]:
+    return [(8.0 + gap, 1.0, 8.5, 5.0)]
+
+
+def wall_track(gap: float) -> Obstacle:
+    """The wall as tracking types it: standing, its cell box S_k (0.5 m cells) reaching
+    over the goal."""
+    lo_x = math.floor((8.0 + gap) / 0.5 + 0.5)
+    return Obstacle(1, "static", (8.25, 3.0), (0.0, 0.0), 2.0, (lo_x, 17, 2, 10))
+
+
+@pytest.mark.parametrize("speed", [0.05, 0.0])
+def test_on_the_last_stretch_the_wall_s_cell_box_over_the_goal_is_no_b(speed: float) -> None:
+    pose = (6.8, 3.0, 0.0)
+    robot = np.array(pose[:2])
+    scan = scan_of(pose, boxes=wall_beyond_goal(0.05))
+    p = planner(final_approach_speed=speed)
+    for t in (0.0, 2.5):
+        d = p.step(pose, [wall_track(0.05)], t, scan)
+    # The wall's box S_k covers the goal: the paper's (b) test finds a threat ...
+    assert [(n.letter, n.threat) for n in d.notes] == [("b", True)]
+    last = p.last_stretch(robot, pose[2], scan)
+    assert last is (speed > 0.0)
+    # ... answered unless the map clears the way (here it does not: a young track) or
+    # the robot is on the last stretch.
+    threats = p._threats(list(d.notes), False, 2.5, robot, p.goal, True, last)
+    assert [a.letter for a in threats] == ([] if speed > 0.0 else ["b"])
+
+
+def test_a_box_on_the_way_to_a_goal_by_a_wall_is_still_a_b() -> None:
+    pose = (6.0, 3.0, 0.0)
+    boxes = [*wall_beyond_goal(0.05), (7.0, 2.85, 7.3, 3.15)]
+    p = planner()
+    assert not p.last_stretch(np.array(pose[:2]), pose[2], scan_of(pose, boxes=boxes))
+    p.step(pose, [], 0.0, scan_of(pose, boxes=boxes))  # (the map: the goal is beside a wall)
+    assert not p.last_stretch(np.array(pose[:2]), pose[2], scan_of(pose, boxes=boxes))
+
+
+@pytest.mark.parametrize("speed", [0.05, 0.0])
+def test_where_the_zone_at_the_speed_asked_refuses_the_goal_the_robot_creeps_on(
+        speed: float) -> None:
+    # 0.305 m from the wall: the zone at 0.1 m/s reaches 0.315 m, at 0.05 m/s 0.296 m.
+    pose = (8.05 - 0.305, 3.0, 0.0)
+    p = planner(final_approach_speed=speed)
+    d = p.step(pose, [], 0.0, scan_of(pose, boxes=wall_beyond_goal(0.05)))
+    if speed > 0.0:
+        assert d.v == pytest.approx(0.05) and not d.refused
+    else:
+        assert d.v == 0.0 and d.refused
+
+
+def test_within_the_tolerance_with_no_nearer_point_to_be_had_the_robot_has_arrived() -> None:
+    pose = (8.05 - 0.29, 3.0, 0.0)  # 0.24 m from the goal, 0.29 m from the wall
+    scan = scan_of(pose, boxes=wall_beyond_goal(0.05))
+    p, off = planner(), planner(final_approach_speed=0.0)
+    for t in (0.0, 1.5, 1.6):  # (the map confirms the wall after map_confirm)
+        d = p.step(pose, [], t, scan)
+        off.step(pose, [], t, scan)
+    assert (d.action, d.v, d.omega) == ("goal", 0.0, 0.0)
+    robot = np.array(pose[:2])
+    assert p._arrived_beside(robot, pose[2], scan)
+    assert not off._arrived_beside(robot, pose[2], scan)
+    # 0.02 m farther from the wall the disc can still close in: not yet.
+    farther = (pose[0] - 0.02, 3.0, 0.0)
+    assert not p._arrived_beside(np.array(farther[:2]), 0.0,
+                                 scan_of(farther, boxes=wall_beyond_goal(0.05)))
+
+
+def test_a_goal_with_no_room_for_the_robot_and_its_zone_ends_in_unreachable() -> None:
+    pose = (7.0, 3.0, 0.0)  # within a metre of the goal's tolerance: it has looked
+    p = planner(spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    wall = wall_beyond_goal(0.03)  # 0.03 + 0.25 < 0.2 + 0.096: no room
+    t, d = 0.0, None
+    while t < 60.0:
+        d = p.step(pose, [], t, scan_of(pose, boxes=wall))
+        if d.action == "unreachable":
+            break
+        t = round(t + 0.1, 6)
+    assert d is not None and d.action == "unreachable", d
+    assert p.no_room and p.plan is not None and p.plan.reason == NO_ROOM
+    assert t < 30.0  # one round of the steps, not the stall watch's rounds
+
+
+def test_a_goal_with_room_beside_the_same_wall_is_not_given_up() -> None:
+    pose = (7.0, 3.0, 0.0)
+    p = planner(spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    for k in range(100):
+        d = p.step(pose, [], k * 0.1, scan_of(pose, boxes=wall_beyond_goal(0.06)))
+        assert d.action != "unreachable"
+    assert not p.no_room
 
 
 # -- braking for the goal -----------------------------------------------------------------
