@@ -329,11 +329,12 @@ class Params(MissionParams, StopZoneParams):
     final_approach_speed: float = Field(
         0.05, ge=0, description="beyond the paper: the last stretch to a goal beside what the "
         "laser sees (a wall within the radius plus half safety_margin of it) is judged on the "
-        "scan's returns: no (b) detour while the straight way keeps the radius plus "
-        "safety_margin off them to a point within goal_tolerance of the goal; where the stop "
-        "zone at the speed asked would refuse the goal, the robot closes in at this speed "
-        "(m/s, the zone is shortest then); it has arrived once within the tolerance with no "
-        "nearer point to be had. 0: off"
+        "scan's returns: no (b) detour while the straight way keeps the radius plus the stop "
+        "zone's reach at this speed off them to a point within goal_tolerance of the goal; "
+        "where the zone at the speed asked would refuse the goal, the robot closes in at this "
+        "speed (m/s, the zone is shortest then); it has arrived once within the tolerance "
+        "with no nearer point to be had; a goal with no such point within the tolerance is "
+        "unreachable after one round of the recovery steps. 0: off"
     )
 
     # --- giving way (give_way.py) -----------------------------------------------------
