@@ -99,6 +99,9 @@ SETTLE_REACH_CLOSE = 0.9
 NO_ROOM = "no room at the goal for the robot and its stop zone"
 """Why the goal is unreachable when ``Planner.look_for_room`` finds none."""
 
+LAST_STRETCH = "the last stretch, judged on the scan"
+"""The reason of the straight path to a goal whose cell the map holds (``last_stretch``)."""
+
 NO_ROOM_LOOK = 1.0
 """m beyond the goal's tolerance: no room at the goal starts the recovery steps, one
 after another, once the robot is this near (it has looked from close by)."""
@@ -198,6 +201,8 @@ class Planner:
             max_rounds=params.recovery_rounds))
         self.walled = False  # the goal cut off by the wall memory (``walled_in``)
         self.no_room = False  # no room at the goal, when last looked at (``look_for_room``)
+        self.on_last_stretch = False  # ``last_stretch``, this cycle
+        self.room_seen = False  # room at a goal beside a wall, when last looked at
         self.walled_stamp = -math.inf
         self.trail: list[tuple[float, float]] = []  # where the robot has been, m
         self.last_v = 0.0  # the speed last commanded, m/s
@@ -845,8 +850,7 @@ class Planner:
     # -- the cycle ---------------------------------------------------------------------
 
     def local_layer(
-        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float,
-        scan: ScanData | None = None,
+        self, pose: tuple[float, float, float], obstacles: list[Obstacle], stamp: float
     ) -> Decision:
         """The paper's local layer toward the look-ahead point on the global path:
         assess every obstacle in the window, respond per scenario letter, plan a Morphin
@@ -855,7 +859,7 @@ class Planner:
         robot = np.array(pose[:2], dtype=np.float64)
         in_window = [o for o in obstacles if self._in_window(o, pose)]
         path_target = self.path_target(robot, self._statics(in_window))
-        last_stretch = self.last_stretch(robot, pose[2], scan)
+        last_stretch = self.on_last_stretch
 
         if self.detour is not None:
             reached = c_hypot(*(self.detour.subtarget - robot)) < p.subtarget_reached
@@ -1092,6 +1096,7 @@ class Planner:
         self.update_map(pose, tracked, scan, stamp)
         self.settle_goal(robot)
         self.look_for_room(robot, pose[2], scan)
+        self.on_last_stretch = self.last_stretch(robot, pose[2], scan)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
         if (decision is not None and decision.action in YIELDING
@@ -1108,7 +1113,7 @@ class Planner:
                 # too late for a better one): the hold ends and the local layer answers.
                 self.hold = None
                 decision = None
-            decision = decision or self.local_layer(pose, obstacles, stamp, scan)
+            decision = decision or self.local_layer(pose, obstacles, stamp)
             if decision.action == "stop" and decision.scenario == "b":
                 self.replan_asked = "no way round"  # the local layer found no detour
             decision = self.guard_stop_zone(self.brake_for_goal(decision, pose, scan),
@@ -1129,7 +1134,7 @@ class Planner:
                 *(self.mission_goal - robot)) <= p.goal_tolerance + NO_ROOM_LOOK
             if p.recovery and (walled or cramped or self.recovery.watch(
                     stamp, self.to_go(robot), waiting, decision.refused)):
-                way = (self.plan is None or self.plan.found) and not walled and not cramped
+                way = self._way_known() and not walled and not cramped
                 if cramped and self.recovery.level >= len(STEPS):
                     # A round of the steps has looked again, and there is still no room.
                     self.recovery.give_up()
@@ -1663,6 +1668,11 @@ class Planner:
         self.replan_asked = None
         self.last_replan = stamp
         plan = plan_path(self.costmap, robot, self.goal, reason)
+        if not plan.found and plan.reason == "goal occupied" and self.on_last_stretch:
+            # The goal's cell holds the wall it lies against, but the scan has room
+            # within the tolerance along the straight way: that is the path.
+            plan = GlobalPlan(np.vstack([robot, self.goal]),
+                              c_hypot(*(self.goal - robot)), LAST_STRETCH)
         self.plan = plan
         if not plan.found:
             return  # keep driving the old path; recovery takes it from here
@@ -1731,6 +1741,16 @@ class Planner:
         self.no_room = not room_near((float(self.mission_goal[0]), float(self.mission_goal[1])),
                                      scan.returns(), self._approach_clearance(),
                                      p.goal_tolerance)
+        self.room_seen = not self.no_room
+
+    def _way_known(self) -> bool:
+        """Whether a way to the goal is known: the global plan found one, or the goal's
+        cell holds the wall it lies against ("goal occupied") while the scan, when last
+        looked at, left room within the tolerance (``look_for_room``): the map's 0.1 m
+        cells are coarser than the room."""
+        if self.plan is None or self.plan.found:
+            return True
+        return self.plan.reason == "goal occupied" and self.room_seen
 
     def recover(self, pose: tuple[float, float, float], stamp: float,
                 scan: ScanData | None) -> Decision | None:
@@ -1740,8 +1760,8 @@ class Planner:
         robot = np.array(pose[:2], dtype=np.float64)
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
         if r.active is None and r.level >= len(STEPS) and (
-                (self.plan is not None and not self.plan.found)
-                or self.walled_in(robot, stamp, fresh=True) or self.no_room):
+                not self._way_known() or self.walled_in(robot, stamp, fresh=True)
+                or self.no_room):
             # Every recovery step tried and still no way on the map: give up, clearly.
             r.unreachable = True
             self._walled_off()
