@@ -14,7 +14,14 @@ import pytest
 from tests.planner.scans import scan_of
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
-from zenav.services.planner.decide import NO_ROOM, SPEED_GAP, Decision, Detour, Planner
+from zenav.services.planner.decide import (
+    LAST_STRETCH,
+    NO_ROOM,
+    SPEED_GAP,
+    Decision,
+    Detour,
+    Planner,
+)
 from zenav.services.planner.global_path import point_at, project
 from zenav.services.planner.params import Params
 from zenav.services.planner.prediction import Obstacle
@@ -700,6 +707,35 @@ def test_a_goal_with_room_beside_the_same_wall_is_not_given_up() -> None:
         d = p.step(pose, [], k * 0.1, scan_of(pose, boxes=wall_beyond_goal(0.06)))
         assert d.action != "unreachable"
     assert not p.no_room
+
+
+def replanned_beside_a_wall(gap: float) -> Planner:
+    """The goal (8, 3.02) ``gap`` m below a wall's face, on the face's map cell; the robot
+    0.8 m below it, facing it; the path planned again once the map holds the wall."""
+    p = Planner(Params.model_validate({"goal": (8.0, 3.02), "start": (8.0, 1.0)}))
+    pose = (8.0, 2.22, math.pi / 2)
+    wall = [(5.0, 3.02 + gap, 11.0, 3.52 + gap)]
+    for t in (0.0, 1.5, 1.6):
+        p.step(pose, [], t, scan_of(pose, boxes=wall))
+    p.replan_asked = "retry"
+    p.update_path(np.array(pose[:2]), 1.7)
+    return p
+
+
+def test_on_the_last_stretch_a_goal_on_the_wall_s_cell_has_the_straight_way_for_path() -> None:
+    p = replanned_beside_a_wall(0.05)
+    assert p.on_last_stretch
+    assert p.plan is not None and p.plan.found and p.plan.reason == LAST_STRETCH
+    assert p.path is not None and np.allclose(p.path, [(8.0, 2.22), (8.0, 3.02)])
+
+
+def test_a_goal_on_the_wall_s_cell_is_a_way_known_while_the_scan_leaves_room() -> None:
+    p = replanned_beside_a_wall(0.048)  # room 2 mm deep: not yet on the last stretch
+    assert p.plan is not None and not p.plan.found and p.plan.reason == "goal occupied"
+    assert p.room_seen and not p.no_room and p._way_known()
+    p = replanned_beside_a_wall(0.03)  # no room
+    assert p.plan is not None and p.plan.reason == "goal occupied"
+    assert p.no_room and not p._way_known()
 
 
 # -- braking for the goal -----------------------------------------------------------------
