@@ -1738,9 +1738,10 @@ class Planner:
                 self.no_room = False
             return
         assert scan is not None
+        # (rings 1 cm apart, or a 25th of a tolerance over 0.25 m: at most ~2000 points)
         self.no_room = not room_near((float(self.mission_goal[0]), float(self.mission_goal[1])),
                                      scan.returns(), self._approach_clearance(),
-                                     p.goal_tolerance)
+                                     p.goal_tolerance, step=max(0.01, p.goal_tolerance / 25))
         self.room_seen = not self.no_room
 
     def _way_known(self) -> bool:

@@ -1,4 +1,6 @@
-"""Drive toward a point: the robot's motion between decisions (pure, no I/O)."""
+"""Drive toward a point: the robot's motion between decisions; and how far it can drive
+straight before it comes too near a return, and whether a goal has room for it (pure,
+no I/O)."""
 
 from __future__ import annotations
 
