@@ -355,17 +355,24 @@ def test_a_recovery_step_does_not_end_for_a_walker_with_the_speed_stage_off() ->
     assert d.action == "spin"
 
 
+def until_unreachable(p: Planner, pose: tuple[float, float, float],
+                      boxes: list[tuple[float, float, float, float]],
+                      limit: float) -> tuple[Decision, float]:
+    """Cycles every 0.1 s at ``pose`` among ``boxes`` until the planner declares the goal
+    unreachable (the test fails if it has not by ``limit`` s): that decision and its stamp."""
+    t, d = 0.0, None
+    while t < limit:
+        d = p.step(pose, [], t, scan_of(pose, boxes=boxes))
+        if d.action == "unreachable":
+            return d, t
+        t = round(t + 0.1, 6)
+    raise AssertionError(f"no unreachable within {limit} s: {d}")
+
+
 def test_a_goal_inside_an_obstacle_ends_in_unreachable_and_the_robot_stops() -> None:
     p = planner(progress_timeout=2.0, spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
     wall = [(8.02, 1.0, 8.5, 5.0)]  # its face runs through the goal's cell: no way there
-    t = 0.0
-    d = None
-    while t < 120.0:
-        d = p.step(POSE, [], t, scan_of(POSE, boxes=wall))
-        if d.action == "unreachable":
-            break
-        t = round(t + 0.1, 6)
-    assert d is not None and d.action == "unreachable", d
+    d, t = until_unreachable(p, POSE, wall, 120.0)
     assert p.plan is not None and p.plan.reason == "goal occupied"
     assert d.v == 0.0 and d.omega == 0.0
     assert p.step(POSE, [], t + 1.0).action == "unreachable"  # for good
@@ -689,13 +696,7 @@ def test_a_goal_with_no_room_for_the_robot_and_its_zone_ends_in_unreachable() ->
     pose = (7.0, 3.0, 0.0)  # within a metre of the goal's tolerance: it has looked
     p = planner(spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
     wall = wall_beyond_goal(0.03)  # 0.03 + 0.25 < 0.2 + 0.096: no room
-    t, d = 0.0, None
-    while t < 60.0:
-        d = p.step(pose, [], t, scan_of(pose, boxes=wall))
-        if d.action == "unreachable":
-            break
-        t = round(t + 0.1, 6)
-    assert d is not None and d.action == "unreachable", d
+    _, t = until_unreachable(p, pose, wall, 60.0)
     assert p.no_room and p.plan is not None and p.plan.reason == NO_ROOM
     assert t < 30.0  # one round of the steps, not the stall watch's rounds
 
