@@ -438,7 +438,7 @@ class Planner:
         if not self._beside_in_view(robot, heading, scan):
             return False
         assert scan is not None
-        return self._stops_within_tolerance(robot, scan)
+        return self._straight_in(robot, scan)[1]
 
     def _beside_in_view(self, robot: Vec, heading: float, scan: ScanData | None) -> bool:
         """The final approach is on, the goal is within the window and the laser's field
@@ -463,13 +463,12 @@ class Planner:
         go no farther along the straight way to the goal keeping ``_approach_clearance``
         off the scan's returns."""
         p = self.p
-        if (scan is None or self.costmap is None
-                or c_hypot(*(self.mission_goal - robot)) >= 0.99 * p.goal_tolerance
-                or not self.last_stretch(robot, heading, scan)):
+        if (c_hypot(*(self.mission_goal - robot)) >= 0.99 * p.goal_tolerance
+                or not self._beside_in_view(robot, heading, scan)):
             return False
-        start = (float(robot[0]), float(robot[1]))
-        end = (float(self.goal[0]), float(self.goal[1]))
-        return reach_along(start, end, scan.returns(), self._approach_clearance()) < 1e-3
+        assert scan is not None
+        reach, within = self._straight_in(robot, scan)
+        return within and reach < 1e-3
 
     def _approach_clearance(self) -> float:
         """How near the returns the last stretch takes the robot's centre: its radius
@@ -479,17 +478,16 @@ class Planner:
         return p.robot_radius + stop_distance(p.final_approach_speed, p.zone_reaction,
                                               p.decel, p.zone_margin)
 
-    def _stops_within_tolerance(self, robot: Vec, scan: ScanData) -> bool:
-        """Whether driving straight for the goal (as settled), the robot's centre keeping
-        ``_approach_clearance`` off the scan's returns, ends within the run's tolerance
-        of its goal (a hundredth of it to spare)."""
-        p = self.p
+    def _straight_in(self, robot: Vec, scan: ScanData) -> tuple[float, bool]:
+        """Driving straight for the goal (as settled), the robot's centre keeping
+        ``_approach_clearance`` off the scan's returns: how far it gets (m), and whether
+        it ends within the run's tolerance of its goal (a hundredth of it to spare)."""
         end = (float(self.goal[0]), float(self.goal[1]))
         start = (float(robot[0]), float(robot[1]))
         length = math.dist(start, end)
         reach = reach_along(start, end, scan.returns(), self._approach_clearance())
         stop = robot if length < 1e-12 else robot + (self.goal - robot) * (reach / length)
-        return c_hypot(*(stop - self.mission_goal)) < 0.99 * p.goal_tolerance
+        return reach, c_hypot(*(stop - self.mission_goal)) < 0.99 * self.p.goal_tolerance
 
     def _returns_off_the_way(self, a: Assessment, robot: Vec, target: Vec,
                              to_goal: bool) -> bool:

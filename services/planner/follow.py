@@ -4,6 +4,7 @@ no I/O)."""
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -90,10 +91,22 @@ def room_near(goal: tuple[float, float], points: npt.NDArray[np.float64], cleara
     near = points[np.hypot(points[:, 0] - gx, points[:, 1] - gy) < reach + clearance]
     if near.shape[0] == 0:
         return True
+    ox, oy = _ring_offsets(reach, step)
+    cx, cy = gx + ox, gy + oy
+    gaps = np.hypot(cx[:, None] - near[None, :, 0], cy[:, None] - near[None, :, 1])
+    return bool((gaps.min(axis=1) >= clearance).any())
+
+
+@functools.lru_cache(maxsize=8)
+def _ring_offsets(reach: float, step: float) -> tuple[npt.NDArray[np.float64],
+                                                     npt.NDArray[np.float64]]:
+    """``room_near``'s points round a goal at the origin, made once for a reach and step
+    (read-only: they are shared)."""
     radii = np.linspace(0.0, reach, max(math.ceil(reach / step), 1) + 1)
     counts = np.maximum(np.ceil(2.0 * math.pi * radii / step), 1).astype(np.int64)
     ring = np.repeat(radii, counts)
     turn = np.concatenate([np.arange(k) / k for k in counts.tolist()]) * 2.0 * math.pi
-    cx, cy = gx + ring * np.cos(turn), gy + ring * np.sin(turn)
-    gaps = np.hypot(cx[:, None] - near[None, :, 0], cy[:, None] - near[None, :, 1])
-    return bool((gaps.min(axis=1) >= clearance).any())
+    ox, oy = ring * np.cos(turn), ring * np.sin(turn)
+    ox.flags.writeable = False
+    oy.flags.writeable = False
+    return ox, oy
