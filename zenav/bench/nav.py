@@ -34,8 +34,8 @@ from zenav.batch import (
     verify_count,
 )
 from zenav.bench.common import machine, words
+from zenav.bench.escape import first_in_view, no_escape
 from zenav.engine import ENGINES
-from zenav.services.geometry import wrap_angle
 from zenav.sim.generate import FAMILIES, random_scenario
 from zenav.sim.scenario import Scenario, dump_scenario, load_scenario
 from zenav.sim.unseen import CLASSES, FAMILY_PREFIX, WALKER_CLASSES, solvable, unseen_scenario
@@ -90,6 +90,7 @@ class PlannerSummary:
     decisions: float  # planner events per run
     stuck: list[str]  # runs not reached that ended standing > STILL_LIMIT with a way known
     hit_unwarned: list[str]  # collisions no scan could have warned of (``no_warning``)
+    hit_no_escape: list[str]  # the others with no way out once seen (``escape.no_escape``)
 
     def rate(self, count: int) -> float:
         return count / self.runs if self.runs else math.nan
@@ -116,27 +117,12 @@ def still_at_end(trajectory: Sequence[Sequence[float]]) -> float:
 def never_in_view(scenario: Scenario, record: dict[str, Any]) -> bool:
     """Whether the run ended in contact with an obstacle whose centre was never inside
     the laser's field (within ``fov_deg / 2`` of the heading and ``max_range``) at any
-    tick of the run. Occlusion is ignored, so this is what the laser could not have seen
-    even with nothing in the way. ORCA agents are placed by the record's own rows."""
+    tick of the run (``escape.first_in_view``). Occlusion is ignored, so this is what the
+    laser could not have seen even with nothing in the way."""
     index = record.get("collided_with")
-    trajectory = record.get("trajectory") or []
-    if record.get("outcome") != "collision" or index is None or not trajectory:
+    if record.get("outcome") != "collision" or index is None or not record.get("trajectory"):
         return False
-    half = math.radians(scenario.laser.fov_deg) / 2
-    reach = scenario.laser.max_range
-    ob = scenario.obstacles[index]
-    rows = record.get("agents", {}).get(str(index))
-    for k, (t, x, y, heading, _) in enumerate(trajectory):
-        if rows is not None:
-            cx, cy = rows[k][1], rows[k][2]
-        elif ob.exists_at(t):
-            cx, cy = ob.center_at(t)
-        else:
-            continue
-        bearing = wrap_angle(math.atan2(cy - y, cx - x) - heading)
-        if abs(bearing) <= half and math.hypot(cx - x, cy - y) <= reach:
-            return False
-    return True
+    return first_in_view(scenario, record, index) is None
 
 
 def appeared_at_contact(scenario: Scenario, record: dict[str, Any]) -> bool:
@@ -163,10 +149,12 @@ def no_warning(scenario: Scenario, record: dict[str, Any]) -> bool:
 def summarise(records: list[dict[str, Any]], planners: Sequence[str],
               has_way: Callable[[str], bool] = lambda name: True,
               unwarned_hit: Callable[[dict[str, Any]], bool] = lambda record: False,
+              no_escape_hit: Callable[[dict[str, Any]], bool] = lambda record: False,
               ) -> tuple[list[PlannerSummary], dict[str, dict[str, float]]]:
     """Per planner and per family; ``has_way``: whether a world (by name) has a way for
     the robot's disc on its static geometry (a run stuck there was the planner's);
-    ``unwarned_hit``: whether a run ended hit by something no scan could warn of."""
+    ``unwarned_hit``: whether a run ended hit by something no scan could warn of;
+    ``no_escape_hit``: whether it ended hit by a mover it had no way out from once seen."""
     by_planner: dict[str, list[dict[str, Any]]] = {p: [] for p in planners}
     for r in records:
         by_planner.setdefault(r["planner"], []).append(r)
@@ -200,6 +188,9 @@ def summarise(records: list[dict[str, Any]], planners: Sequence[str],
                    and has_way(r["scenario"])],
             hit_unwarned=[r["scenario"] for r in valid
                           if r["outcome"] == "collision" and unwarned_hit(r)],
+            hit_no_escape=[r["scenario"] for r in valid
+                           if r["outcome"] == "collision" and not unwarned_hit(r)
+                           and no_escape_hit(r)],
         ))
     families: dict[str, dict[str, float]] = {}
     for p in planners:
@@ -292,6 +283,15 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
                      f"{len(paper.hit_unwarned)} of {paper.collisions}"
                      + (f" ({', '.join(paper.hit_unwarned)})" if paper.hit_unwarned else "")
                      + ".")
+        warned = paper.collisions - len(paper.hit_unwarned)
+        if warned:
+            lines.append(
+                "Of the others, with a mover of the world's own that left the robot no way "
+                "out once a planner could act on it (standing, or any heading at its top "
+                "speed, in open space with the mover's true path known: "
+                f"`zenav.bench.escape`): {len(paper.hit_no_escape)} of {warned}"
+                + (f" ({', '.join(paper.hit_no_escape)})" if paper.hit_no_escape else "")
+                + ".")
     others = [s for s in summaries if s.planner != "paper"]
     if others:
         ahead = all(paper.rate(paper.reached) > s.rate(s.reached) for s in others)
@@ -392,7 +392,12 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
         return (record["outcome"] == "collision" and name in world_files
                 and no_warning(load_scenario(world_files[name]), record))
 
-    summaries, per_family = summarise(records, planners, has_way, unwarned_hit)
+    def no_escape_hit(record: dict[str, Any]) -> bool:
+        name = record["scenario"]
+        return (record["outcome"] == "collision" and name in world_files
+                and no_escape(load_scenario(world_files[name]), record))
+
+    summaries, per_family = summarise(records, planners, has_way, unwarned_hit, no_escape_hit)
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
                                    f" --families {','.join(families)}")

@@ -1,0 +1,148 @@
+"""Whether a robot hit by a mover could have got out of its way at all, once it could know
+of it (pure: a scenario and a run record in, a verdict out).
+
+``zenav bench nav`` counts the collisions no scan could have warned of
+(:func:`zenav.bench.nav.no_warning`). A mover that was in view can still leave no way out:
+a robot whose top speed is 0.2 m/s cannot leave the way of a disc at 0.6 m/s seen 1 m off.
+:func:`no_escape` asks, for a collision with a mover of the scenario's own (a disc or box
+at constant velocity, not an ORCA agent, whose walk depends on the robot), whether any of a
+set of simple manoeuvres would have kept the robot out of contact with that mover, driven
+from the moment a planner could first act on it, with the mover's true path known:
+
+- the moment: the first tick the mover's centre was in the laser's field of view and range
+  (occlusion aside, as ``never_in_view``), plus two laser periods (a scan to see it, one
+  more to know it moves);
+- the manoeuvres: stand (brake at the planner's ``decel``), or turn toward a heading (every
+  ``HEADING_STEP_DEG`` degrees round the circle) and drive it at the robot's top speed, as
+  the planner's own roll-outs drive the robot (:func:`zenav.services.planner.safety.drive_out`:
+  turn rate, heading gain, acceleration and braking limits);
+- kept out of contact: the robot's disc never touches the mover's shape at any step of
+  ``STEP`` s until the mover has gone ``PASSED`` m beyond the robot's place at that moment
+  (at most ``HORIZON`` s), or has vanished.
+
+Everything else is left out in the robot's favour: the walls and the other obstacles,
+other manoeuvres' shapes, and the robot's own view of the mover (its estimate, not the
+truth). So a "no escape" verdict is conservative: not even this robot, knowing the
+future, in open space, could have kept clear. A run with an escape is not thereby a
+planner's fault: the escape may run into a wall or another mover.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from zenav.services.geometry import wrap_angle
+from zenav.services.planner import safety
+from zenav.services.planner.params import Params
+from zenav.sim.scenario import ObstacleSpec, Scenario
+
+HEADING_STEP_DEG = 5.0  # between the headings tried, degrees
+STEP = 0.05  # s between the points checked
+PASSED = 3.0  # m the mover must have gone beyond the robot's place
+HORIZON = 30.0  # s: the longest a manoeuvre is followed
+SCANS_TO_ACT = 2  # laser periods from the first sight to the first answer
+
+Vec = npt.NDArray[np.float64]
+
+
+def first_in_view(scenario: Scenario, record: dict[str, Any], index: int) -> int | None:
+    """The first row of the record's trajectory at which obstacle ``index`` exists and its
+    centre is within the laser's field of view and range, occlusion aside; None if it
+    never is. ORCA agents are placed by the record's own rows (its ``agents`` field)."""
+    half = math.radians(scenario.laser.fov_deg) / 2
+    reach = scenario.laser.max_range
+    ob = scenario.obstacles[index]
+    rows = record.get("agents", {}).get(str(index))
+    for k, (t, x, y, heading, _) in enumerate(record.get("trajectory") or []):
+        if rows is not None:
+            cx, cy = rows[k][1], rows[k][2]
+        elif ob.exists_at(t):
+            cx, cy = ob.center_at(t)
+        else:
+            continue
+        bearing = wrap_angle(math.atan2(cy - y, cx - x) - heading)
+        if abs(bearing) <= half and math.hypot(cx - x, cy - y) <= reach:
+            return k
+    return None
+
+
+def surface_distance(ob: ObstacleSpec, xs: Vec, ys: Vec, times: Vec) -> Vec:
+    """Signed distance (m, < 0 inside) from each point ``(xs[i, j], ys[i, j])`` to the
+    obstacle's shape at ``times[j]`` s, as :meth:`ObstacleSpec.signed_distance` gives it
+    point by point."""
+    dt = times - ob.appear
+    dx = xs - (ob.center[0] + ob.velocity[0] * dt)
+    dy = ys - (ob.center[1] + ob.velocity[1] * dt)
+    if ob.shape == "disc":
+        assert ob.radius is not None
+        return np.asarray(np.hypot(dx, dy) - ob.radius)
+    assert ob.size is not None
+    qx = np.abs(dx) - ob.size[0] / 2.0
+    qy = np.abs(dy) - ob.size[1] / 2.0
+    outside = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0))
+    return np.asarray(outside + np.minimum(np.maximum(qx, qy), 0.0))
+
+
+def escape_horizon(ob: ObstacleSpec, robot: tuple[float, float], t0: float) -> float:
+    """s from ``t0`` until the mover is ``PASSED`` m beyond ``robot`` along its way (at
+    most ``HORIZON``, and never past its vanishing)."""
+    speed = math.hypot(*ob.velocity)
+    cx, cy = ob.center_at(t0)
+    along = ((robot[0] - cx) * ob.velocity[0] + (robot[1] - cy) * ob.velocity[1]) / speed
+    horizon = min(max(along + PASSED, 0.0) / speed, HORIZON)
+    return max(min(horizon, ob.vanish_time - t0), STEP)
+
+
+def robot_model(scenario: Scenario, pose: tuple[float, float, float], speed: float
+                ) -> safety.Robot:
+    """The robot as the planner's roll-outs drive it: the planner's default turn rate,
+    heading gain and acceleration limits, the scenario's radius and top speed."""
+    p = Params()
+    return safety.Robot(x=pose[0], y=pose[1], heading=pose[2], speed=speed,
+                        radius=scenario.robot.radius,
+                        max_speed=scenario.robot.effective_max_speed, max_omega=p.max_omega,
+                        heading_gain=p.heading_gain, accel=p.accel, decel=p.decel)
+
+
+def can_escape(scenario: Scenario, ob: ObstacleSpec, pose: tuple[float, float, float],
+               speed: float, t0: float) -> bool:
+    """Whether standing, or one of the headings every ``HEADING_STEP_DEG`` at the top
+    speed, driven from ``pose`` (moving at ``speed``) at ``t0`` s, keeps the robot's disc
+    off the mover ``ob`` until it has passed."""
+    robot = robot_model(scenario, pose, speed)
+    horizon = escape_horizon(ob, pose[:2], t0)
+    times = STEP * np.arange(1, max(round(horizon / STEP), 1) + 1, dtype=np.float64)
+    fan = np.radians(np.arange(0.0, 360.0, HEADING_STEP_DEG))
+    headings = np.concatenate(([pose[2]], fan))
+    speeds = np.concatenate(([0.0], np.full(fan.shape[0], robot.max_speed)))
+    xs, ys, _ = safety.drive_out(robot, headings, speeds, times)
+    gaps = surface_distance(ob, xs, ys, t0 + times) - robot.radius
+    return bool((gaps.min(axis=1) > 0.0).any())
+
+
+def no_escape(scenario: Scenario, record: dict[str, Any]) -> bool:
+    """Whether the run ended in contact with a mover of the scenario's own (constant
+    velocity; not an ORCA agent) that, from the first moment a planner could act on it
+    (``SCANS_TO_ACT`` laser periods after it first came into view), no manoeuvre of
+    ``can_escape`` would have kept clear of. False for every other run, and for a mover
+    never in view (``never_in_view`` counts those)."""
+    index = record.get("collided_with")
+    trajectory = record.get("trajectory") or []
+    if record.get("outcome") != "collision" or index is None or not trajectory:
+        return False
+    ob = scenario.obstacles[index]
+    if ob.is_agent or ob.is_static:
+        return False
+    seen = first_in_view(scenario, record, index)
+    if seen is None:
+        return False
+    t_act = trajectory[seen][0] + SCANS_TO_ACT / scenario.laser.rate_hz
+    row = next((r for r in trajectory if r[0] >= t_act - 1e-9), None)
+    if row is None:
+        return True  # the run ended before a planner could answer
+    t, x, y, heading, speed = row
+    return not can_escape(scenario, ob, (x, y, heading), speed, t)
