@@ -7,7 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from zenav.bench.escape import can_escape, first_in_view, no_escape, surface_distance
+from zenav.bench.escape import (
+    can_escape,
+    escape_horizon,
+    first_in_view,
+    no_escape,
+    surface_distance,
+)
 from zenav.bench.nav import goal_lines, summarise
 from zenav.sim.scenario import Scenario
 
@@ -59,6 +65,12 @@ def test_a_fast_mover_seen_close_leaves_a_slow_robot_no_way_out() -> None:
     # A mover whose line passes 1 m to the side: standing is enough.
     wide = world({"center": [1.0, 1.0], "velocity": [-0.6, 0.0]})
     assert can_escape(wide, wide.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
+    # A disc standing 0.5 m ahead of a standing robot: standing keeps clear of it for the
+    # whole horizon (30 s); from 0.15 m on, the robot's disc already touches it.
+    still = world({"center": [0.5, 0.0], "velocity": [0.0, 0.0]})
+    assert escape_horizon(still.obstacles[1], (0.0, 0.0), 0.0) == 30.0
+    assert can_escape(still, still.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert not can_escape(still, still.obstacles[1], (0.15, 0.0, 0.0), 0.0, 0.0)
 
 
 def test_a_robot_faster_than_the_mover_runs_ahead_of_one_from_behind() -> None:

@@ -89,11 +89,13 @@ def surface_distance(ob: ObstacleSpec, xs: Vec, ys: Vec, times: Vec) -> Vec:
 
 def escape_horizon(ob: ObstacleSpec, robot: tuple[float, float], t0: float) -> float:
     """s from ``t0`` until the mover is ``PASSED`` m beyond ``robot`` along its way (at
-    most ``HORIZON``, and never past its vanishing)."""
+    most ``HORIZON``, and never past its vanishing; a standing obstacle never passes)."""
     speed = math.hypot(*ob.velocity)
-    cx, cy = ob.center_at(t0)
-    along = ((robot[0] - cx) * ob.velocity[0] + (robot[1] - cy) * ob.velocity[1]) / speed
-    horizon = min(max(along + PASSED, 0.0) / speed, HORIZON)
+    horizon = HORIZON
+    if speed > 0.0:
+        cx, cy = ob.center_at(t0)
+        along = ((robot[0] - cx) * ob.velocity[0] + (robot[1] - cy) * ob.velocity[1]) / speed
+        horizon = min(max(along + PASSED, 0.0) / speed, HORIZON)
     return max(min(horizon, ob.vanish_time - t0), STEP)
 
 
