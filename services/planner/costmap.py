@@ -44,6 +44,7 @@ Cells are indexed ``[ix, iy]``; cell (0, 0) spans [origin, origin + resolution) 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import TypeVar
@@ -85,9 +86,11 @@ class ScanData:
     range_max: float  # m
     range_min: float = 0.0
 
+    @functools.cached_property
     def returns(self) -> npt.NDArray[np.float64]:
         """(n, 2) global points of the beams that returned (``range_min`` <= range <
-        ``range_max``), by Eq. 1 (``to_global``)."""
+        ``range_max``), by Eq. 1 (``to_global``); made once a scan, however many of the
+        planner's checks read it."""
         beams = np.flatnonzero((self.ranges >= self.range_min)
                                & (self.ranges < self.range_max))
         x, y = to_global(self.pose, self.ranges[beams],

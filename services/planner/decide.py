@@ -485,7 +485,7 @@ class Planner:
         end = (float(self.goal[0]), float(self.goal[1]))
         start = (float(robot[0]), float(robot[1]))
         length = math.dist(start, end)
-        reach = reach_along(start, end, scan.returns(), self._approach_clearance())
+        reach = reach_along(start, end, scan.returns, self._approach_clearance())
         stop = robot if length < 1e-12 else robot + (self.goal - robot) * (reach / length)
         return reach, c_hypot(*(stop - self.mission_goal)) < 0.99 * self.p.goal_tolerance
 
@@ -1738,7 +1738,7 @@ class Planner:
         assert scan is not None
         # (rings 1 cm apart, or a 25th of a tolerance over 0.25 m: at most ~2000 points)
         self.no_room = not room_near((float(self.mission_goal[0]), float(self.mission_goal[1])),
-                                     scan.returns(), self._approach_clearance(),
+                                     scan.returns, self._approach_clearance(),
                                      p.goal_tolerance, step=max(0.01, p.goal_tolerance / 25))
         self.room_seen = not self.no_room
 

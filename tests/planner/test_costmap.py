@@ -149,7 +149,7 @@ def test_returns_not_yet_confirmed_are_found_near_a_segment() -> None:
 def test_a_scan_s_returns_are_where_its_beams_met_something_in_the_global_frame() -> None:
     pose = (1.0, 2.0, math.pi / 2)  # facing +y
     scan = scan_of(pose, boxes=[(0.0, 4.0, 2.0, 4.2)], range_max=8.0)
-    points = scan.returns()
+    points = scan.returns
     hits = int(np.count_nonzero(scan.ranges < scan.range_max))
     assert 0 < hits < scan.ranges.shape[0] and points.shape == (hits, 2)
     assert np.allclose(points[:, 1], 4.0, atol=1e-9)  # on the wall's near face
