@@ -111,6 +111,11 @@ def test_a_sweep_makes_every_run_again_unless_told_to_reuse(tmp_path, monkeypatc
     rows = json.loads((tmp_path / "crowd.json").read_text())["settings"]
     assert rows["circle-invisible-360"][0]["collision"] == (0.5 if reuse else 0.0)
     assert ("--reuse" in report) == reuse
+    # The kept record is a collision the report accounts for (with no obstacle named, it
+    # is neither unwarned nor without a way out).
+    assert ("Collisions: paper 1 (0 never in view before the contact, 0 with no way out "
+            "once seen)" in report) == reuse
+    assert ("No collisions." in report) != reuse
 
 
 @pytest.mark.parametrize("disagree", [False, True])
@@ -147,3 +152,51 @@ def test_the_report_says_what_the_stack_said_of_the_runs_it_made_again(tmp_path,
     summary = json.loads((tmp_path / "crowd.json").read_text())
     assert summary["verified"] == ["circle-invisible-360/paper/0"]
     assert len(summary["disagreements"]) == int(disagree)
+
+
+def test_a_collision_is_unwarned_without_a_way_out_or_with_one():
+    """Each collision's kind, from the scenario and the record (``zenav.bench.escape`` on a
+    walker blind to the robot), counted per planner and said under the setting's table."""
+    from zenav.bench.crowd import NO_WAY_OUT, UNWARNED, WAY_OUT, collision_kind, collisions_line
+    from zenav.sim.scenario import Scenario
+
+    def walker(x: float, vx: float) -> Scenario:
+        # A robot at the origin facing east (top speed 0.2 m/s, 180-degree laser) and an
+        # ORCA walker at 1 m/s on its line, blind to it, obstacle 0.
+        return Scenario.model_validate({
+            "name": "w", "world": {"size": [20.0, 20.0], "cell": 0.5},
+            "robot": {"start": [0.0, 0.0], "goal": [8.0, 0.0], "speed": 0.1, "radius": 0.2},
+            "obstacles": [{"shape": "disc", "behavior": "orca", "center": [x, 0.0],
+                           "radius": 0.3, "goals": [[x + 13.0 * vx, 0.0]],
+                           "preferred_speed": 1.0}],
+            "duration": 25.0})
+
+    def hit(x: float, vx: float, until: float) -> dict[str, Any]:
+        ticks = round(until * 10) + 1
+        return {"scenario": "w", "planner": "paper", "outcome": "collision", "time": until,
+                "collided_with": 0,
+                "trajectory": [[k / 10, 0.0, 0.0, 0.0, 0.0] for k in range(ticks)],
+                "agents": {"0": [[k / 10, x + vx * k / 10, 0.0] for k in range(ticks)]}}
+
+    # Head-on from 3 m: in view at once, but too close for a robot of 0.2 m/s to leave.
+    assert collision_kind(walker(3.0, -1.0), hit(3.0, -1.0, 2.5)) == NO_WAY_OUT
+    # Head-on from 8 m: time enough to step aside.
+    assert collision_kind(walker(8.0, -1.0), hit(8.0, -1.0, 7.5)) == WAY_OUT
+    # From behind, out of the 180-degree view until it touches.
+    assert collision_kind(walker(-3.0, 1.0), hit(-3.0, 1.0, 2.5)) == UNWARNED
+    assert collision_kind(walker(3.0, -1.0), {**hit(3.0, -1.0, 2.5), "outcome": "reached"}) \
+        is None
+
+    kinds = [NO_WAY_OUT, WAY_OUT, UNWARNED]
+    records = [{**record("paper", "collision", 1.0, [0.0]), "hit": k} for k in kinds]
+    records.append(record("paper", "reached", 9.0, [1.0]))
+    (paper,) = summarise(records, ["paper"])
+    assert (paper.collisions, paper.unwarned, paper.no_way_out) == (3, 1, 1)
+    assert collisions_line([paper], visible=False).startswith(
+        "Collisions: paper 3 (1 never in view before the contact, 1 with no way out once "
+        "seen).")
+    seen = collisions_line([paper], visible=True)
+    assert seen.startswith("Collisions: paper 3 (1 never in view before the contact).")
+    assert "not judged" in seen
+    (idle,) = summarise([record("paper", "reached", 9.0, [1.0])], ["paper"])
+    assert collisions_line([idle], visible=False) == "No collisions."

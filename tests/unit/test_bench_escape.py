@@ -6,8 +6,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pytest
 
 from zenav.bench.escape import (
+    agent_gap,
     can_escape,
     escape_horizon,
     first_in_view,
@@ -58,19 +60,19 @@ def test_a_fast_mover_seen_close_leaves_a_slow_robot_no_way_out() -> None:
     # 0.6 m/s straight at a robot whose top speed is 0.2 m/s, its disc 0.55 m off: the
     # contact comes in under a second; a quarter turn alone takes over a second.
     close = world({"center": [1.0, 0.0], "velocity": [-0.6, 0.0]})
-    assert not can_escape(close, close.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert not can_escape(close, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
     # Seen 6 m off, the same mover leaves ten seconds to step out of its way.
     far = world({"center": [6.0, 0.0], "velocity": [-0.6, 0.0]})
-    assert can_escape(far, far.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert can_escape(far, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
     # A mover whose line passes 1 m to the side: standing is enough.
     wide = world({"center": [1.0, 1.0], "velocity": [-0.6, 0.0]})
-    assert can_escape(wide, wide.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert can_escape(wide, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
     # A disc standing 0.5 m ahead of a standing robot: standing keeps clear of it for the
     # whole horizon (30 s); from 0.15 m on, the robot's disc already touches it.
     still = world({"center": [0.5, 0.0], "velocity": [0.0, 0.0]})
     assert escape_horizon(still.obstacles[1], (0.0, 0.0), 0.0) == 30.0
-    assert can_escape(still, still.obstacles[1], (0.0, 0.0, 0.0), 0.0, 0.0)
-    assert not can_escape(still, still.obstacles[1], (0.15, 0.0, 0.0), 0.0, 0.0)
+    assert can_escape(still, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert not can_escape(still, 1, (0.15, 0.0, 0.0), 0.0, 0.0)
 
 
 def test_a_robot_faster_than_the_mover_runs_ahead_of_one_from_behind() -> None:
@@ -79,9 +81,9 @@ def test_a_robot_faster_than_the_mover_runs_ahead_of_one_from_behind() -> None:
     # gap shrinks by at most 0.25 m); one of 0.2 m/s is caught within 1.8 s, too soon
     # to turn a right angle and get its disc off the mover's line.
     behind = {"center": [-1.0, 0.0], "velocity": [0.5, 0.0]}
-    assert can_escape(world(behind, speed=0.3), world(behind).obstacles[1],
+    assert can_escape(world(behind, speed=0.3), 1,
                       (0.0, 0.0, 0.0), 0.0, 0.0)
-    assert not can_escape(world(behind, speed=0.1), world(behind).obstacles[1],
+    assert not can_escape(world(behind, speed=0.1), 1,
                           (0.0, 0.0, 0.0), 0.0, 0.0)
 
 
@@ -109,6 +111,35 @@ def test_no_escape_judges_from_two_scans_after_the_mover_first_came_into_view() 
     behind = world({"center": [-6.0, 0.0], "velocity": [-0.6, 0.0]})
     assert first_in_view(behind, hit(9.0), 1) is None
     assert not no_escape(behind, hit(9.0))
+
+
+def walker(center: list[float], goal: list[float], sees_robot: bool = False) -> Scenario:
+    """The robot of ``world`` (top speed 0.2 m/s) and one ORCA walker at 1 m/s, obstacle
+    1, alone in the crowd: it walks straight at its goal."""
+    return world({"behavior": "orca", "center": center, "radius": 0.3, "goals": [goal],
+                  "preferred_speed": 1.0, "sees_robot": sees_robot})
+
+
+def test_a_walker_blind_to_the_robot_is_judged_on_its_own_path() -> None:
+    # Alone, it walks at 1 m/s from (3, 0) toward (-5, 0): centre (3 - t, 0).
+    ahead = walker([3.0, 0.0], [-5.0, 0.0])
+    gap = agent_gap(ahead, 1)
+    got = gap(np.array([[0.0, 0.0]]), np.array([[0.0, 1.0]]), np.array([1.0, 2.5]))
+    assert np.allclose(got, [[2.0 - 0.3, np.hypot(0.5, 1.0) - 0.3]], atol=1e-6)
+    # Head-on 3 m off: the discs touch 2.5 s in, too soon for a robot of 0.2 m/s to turn
+    # a right angle (1.6 s) and take its disc 0.5 m off the walker's line.
+    assert not can_escape(ahead, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
+    assert no_escape(ahead, {**hit(2.5), "agents": {"1": [[k / 10, 3.0 - k / 10, 0.0]
+                                                           for k in range(26)]}})
+    # Seen 8 m off, the same walk leaves the time to step aside.
+    far = walker([8.0, 0.0], [-5.0, 0.0])
+    assert can_escape(far, 1, (0.0, 0.0, 0.0), 0.0, 0.0)
+    # A walker that sees the robot walks round it as the robot moves: no verdict.
+    seeing = walker([3.0, 0.0], [-5.0, 0.0], sees_robot=True)
+    assert not no_escape(seeing, {**hit(2.5), "agents": {"1": [[k / 10, 3.0 - k / 10, 0.0]
+                                                              for k in range(26)]}})
+    with pytest.raises(ValueError, match="sees the robot"):
+        agent_gap(seeing, 1)
 
 
 def test_the_report_counts_no_way_out_among_the_collisions_a_scan_warned_of() -> None:

@@ -49,7 +49,7 @@ from zenav.sim.crowdnav import (
     check_cases,
     crowdnav_scenario,
 )
-from zenav.sim.scenario import dump_scenario
+from zenav.sim.scenario import Scenario, dump_scenario, load_scenario
 
 __all__ = ["ENGINES", "SETTINGS", "Setting", "discomfort_steps", "run_crowd", "summarise"]
 
@@ -135,6 +135,9 @@ class Row:
     timeout: float
     time_to_goal: float  # mean over the successes, s
     discomfort: float  # fraction of ticks
+    collisions: int = 0
+    unwarned: int = 0  # collisions no scan could have warned of (``nav.no_warning``)
+    no_way_out: int = 0  # the others that left no way out once seen (``escape.no_escape``)
 
     def cells(self) -> list[str]:
         def rate(x: float) -> str:
@@ -165,8 +168,52 @@ def summarise(records: Sequence[Record], planners: Sequence[str]) -> list[Row]:
                         collision=counts["collision"] / n if n else math.nan,
                         timeout=counts["timeout"] / n if n else math.nan,
                         time_to_goal=statistics.fmean(times) if times else math.nan,
-                        discomfort=close / total if total else math.nan))
+                        discomfort=close / total if total else math.nan,
+                        collisions=counts["collision"],
+                        unwarned=sum(r.get("hit") == UNWARNED for r in valid),
+                        no_way_out=sum(r.get("hit") == NO_WAY_OUT for r in valid)))
     return rows
+
+
+UNWARNED = "unwarned"
+NO_WAY_OUT = "no way out"
+WAY_OUT = "way out"
+
+
+def collision_kind(scenario: Scenario, record: Record) -> str | None:
+    """What a collision left the robot: ``UNWARNED`` (no scan could have warned of the
+    human: :func:`zenav.bench.nav.no_warning`), ``NO_WAY_OUT`` (in view, but with a path
+    of its own that left no way out once a planner could act on it:
+    :func:`zenav.bench.escape.no_escape`, for humans blind to the robot only) or
+    ``WAY_OUT``; None for a run that did not end in a collision."""
+    from zenav.bench.escape import no_escape
+    from zenav.bench.nav import no_warning
+
+    if record.get("outcome") != "collision":
+        return None
+    if no_warning(scenario, record):
+        return UNWARNED
+    return NO_WAY_OUT if no_escape(scenario, record) else WAY_OUT
+
+
+def collisions_line(rows: Sequence[Row], visible: bool) -> str:
+    """One line under a setting's table: each planner's collisions, those no scan could
+    have warned of, and (humans blind to the robot) those that left no way out."""
+    parts = []
+    for r in rows:
+        if not r.collisions:
+            continue
+        part = f"{r.planner} {r.collisions} ({r.unwarned} never in view before the contact"
+        parts.append(part + ("" if visible else f", {r.no_way_out} with no way out once "
+                             "seen") + ")")
+    if not parts:
+        return "No collisions."
+    why = ("" if not visible else " Humans who see the robot walk as it moves, so whether "
+           "it had a way out is not judged here.")
+    return ("Collisions: " + "; ".join(parts) + ". Never in view: the human's centre was "
+            "never within the laser's field and range (occlusion aside); no way out: "
+            "standing, or any heading at the robot's top speed, in open space with the "
+            "human's path known, touched it (`zenav.bench.escape`)." + why)
 
 
 HEADER = ("| planner | runs | success | collision | timeout | time to goal s | discomfort |\n"
@@ -274,6 +321,8 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
             nonlocal reached
             record.setdefault("scenario", job.name)
             record["planner"] = job.planner
+            if record["outcome"] == "collision":
+                record["hit"] = collision_kind(load_scenario(job.scenario), record)
             records[job.key.split("/", 1)[0]].append(record)
             reached += record["outcome"] == "reached"
             finished = sum(len(v) for v in records.values())
@@ -301,7 +350,8 @@ def run_crowd(planners: Sequence[str], out: Path, *, cases: int = 500, seed: int
              "the mean over the successes; discomfort is the fraction of simulator ticks "
              "with the robot within 0.2 m of a human (surface to surface).\n"]
     for name in settings:
-        parts.append(f"\n## {SETTINGS[name].title}\n\n{table(results[name])}\n")
+        parts.append(f"\n## {SETTINGS[name].title}\n\n{table(results[name])}\n\n"
+                     f"{collisions_line(results[name], SETTINGS[name].visible)}\n")
     report = "".join(parts)
     (out / "crowd.md").write_text(report)
     (out / "crowd.json").write_text(json.dumps(

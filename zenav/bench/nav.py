@@ -286,9 +286,10 @@ def goal_lines(summaries: list[PlannerSummary], families: dict[str, dict[str, fl
         warned = paper.collisions - len(paper.hit_unwarned)
         if warned:
             lines.append(
-                "Of the others, with a mover of the world's own that left the robot no way "
-                "out once a planner could act on it (standing, or any heading at its top "
-                "speed, in open space with the mover's true path known: "
+                "Of the others, with a mover whose path does not depend on the robot (the "
+                "world's own, or a walker blind to it) that left the robot no way out once "
+                "a planner could act on it (standing, or any heading at its top speed, in "
+                "open space with the mover's true path known: "
                 f"`zenav.bench.escape`): {len(paper.hit_no_escape)} of {warned}"
                 + (f" ({', '.join(paper.hit_no_escape)})" if paper.hit_no_escape else "")
                 + ".")
