@@ -140,6 +140,18 @@ def test_a_walker_blind_to_the_robot_is_judged_on_its_own_path() -> None:
                                                               for k in range(26)]}})
     with pytest.raises(ValueError, match="sees the robot"):
         agent_gap(seeing, 1)
+    # A blind walker among others that see the robot: they move it as the robot moves
+    # them, so it gets no verdict either.
+    mixed = Scenario.model_validate({
+        **ahead.model_dump(mode="json", exclude_none=True),
+        "obstacles": [*ahead.model_dump(mode="json", exclude_none=True)["obstacles"],
+                      {"shape": "disc", "behavior": "orca", "center": [0.0, 5.0],
+                       "radius": 0.3, "goals": [[0.0, -5.0]], "preferred_speed": 1.0,
+                       "sees_robot": True}]})
+    assert not mixed.obstacles[1].sees_robot
+    assert not no_escape(mixed, {**hit(2.5), "agents": {
+        "1": [[k / 10, 3.0 - k / 10, 0.0] for k in range(26)],
+        "2": [[k / 10, 0.0, 5.0 - k / 10] for k in range(26)]}})
 
 
 def test_the_report_counts_no_way_out_among_the_collisions_a_scan_warned_of() -> None:

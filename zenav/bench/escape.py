@@ -8,9 +8,10 @@ a robot whose top speed is 0.2 m/s cannot leave the way of a disc at 0.6 m/s see
 robot, whether any of a set of simple manoeuvres would have kept the robot out of contact
 with that mover, driven from the moment a planner could first act on it, with the mover's
 true path known. Such movers are the scenario's discs and boxes at constant velocity, and
-its ORCA agents blind to the robot (``sees_robot: false``, CrowdNav's invisible humans):
-those walk the same paths whatever the robot does, so their paths are made again without
-it (:func:`zenav.bench.bound.humans_paths`). An agent that sees the robot gets no verdict.
+its ORCA agents when all of them are blind to the robot (``sees_robot: false``,
+CrowdNav's invisible humans): those walk the same paths whatever the robot does, so their
+paths are made again without it (:func:`zenav.bench.bound.humans_paths`). Where any agent
+sees the robot, no agent gets a verdict: one that sees it moves the others it meets.
 
 - the moment: the first tick the mover's centre was in the laser's field of view and range
   (occlusion aside, as ``never_in_view``), plus two laser periods (a scan to see it, one
@@ -176,8 +177,9 @@ def no_escape(scenario: Scenario, record: dict[str, Any]) -> bool:
     if record.get("outcome") != "collision" or index is None or not trajectory:
         return False
     ob = scenario.obstacles[index]
-    if ob.is_static or (ob.is_agent and ob.sees_robot):
-        return False
+    if ob.is_static or (ob.is_agent and any(o.is_agent and o.sees_robot
+                                             for o in scenario.obstacles)):
+        return False  # an agent that sees the robot moves the others it meets
     seen = first_in_view(scenario, record, index)
     if seen is None:
         return False
