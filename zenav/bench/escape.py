@@ -123,8 +123,8 @@ def robot_model(scenario: Scenario, pose: tuple[float, float, float], speed: flo
 def agent_gap(scenario: Scenario, index: int) -> Gap:
     """The distance function of obstacle ``index``, an ORCA agent blind to the robot: its
     path made again without the robot at ``STEP`` s ticks to the end of the run (a time
-    is taken at its nearest tick), infinite while it is absent. ValueError for an agent
-    that sees the robot (its path depends on the robot's)."""
+    is taken at its nearest tick), infinite while it is absent. ValueError where any
+    agent sees the robot (the paths then depend on the robot's)."""
     ob = scenario.obstacles[index]
     assert ob.radius is not None
     paths = humans_paths(scenario, scenario.duration, STEP)
@@ -168,10 +168,11 @@ def can_escape(scenario: Scenario, index: int, pose: tuple[float, float, float],
 
 def no_escape(scenario: Scenario, record: dict[str, Any]) -> bool:
     """Whether the run ended in contact with a mover whose path does not depend on the
-    robot (a disc or box at constant velocity, or an agent blind to the robot) that, from
-    the first moment a planner could act on it (``SCANS_TO_ACT`` laser periods after it
-    first came into view), no manoeuvre of ``can_escape`` would have kept clear of. False
-    for every other run, and for a mover never in view (``never_in_view`` counts those)."""
+    robot (a disc or box at constant velocity, or an agent when every agent is blind to
+    the robot) that, from the first moment a planner could act on it (``SCANS_TO_ACT``
+    laser periods after it first came into view), no manoeuvre of ``can_escape`` would
+    have kept clear of. False for every other run, and for a mover never in view
+    (``never_in_view`` counts those)."""
     index = record.get("collided_with")
     trajectory = record.get("trajectory") or []
     if record.get("outcome") != "collision" or index is None or not trajectory:
