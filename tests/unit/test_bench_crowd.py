@@ -157,7 +157,8 @@ def test_the_report_says_what_the_stack_said_of_the_runs_it_made_again(tmp_path,
 def test_a_collision_is_unwarned_without_a_way_out_or_with_one():
     """Each collision's kind, from the scenario and the record (``zenav.bench.escape`` on a
     walker blind to the robot), counted per planner and said under the setting's table."""
-    from zenav.bench.crowd import NO_WAY_OUT, UNWARNED, WAY_OUT, collision_kind, collisions_line
+    from zenav.bench.crowd import collisions_line
+    from zenav.bench.nav import NO_WAY_OUT, UNWARNED, WAY_OUT, collision_kind
     from zenav.sim.scenario import Scenario
 
     def walker(x: float, vx: float) -> Scenario:

@@ -41,6 +41,7 @@ from zenav.batch import (
     verify_count,
 )
 from zenav.bench.common import machine, words
+from zenav.bench.nav import NO_WAY_OUT, UNWARNED, collision_kind
 from zenav.sim.crowdnav import (
     DISCOMFORT,
     HUMAN_RADIUS,
@@ -49,7 +50,7 @@ from zenav.sim.crowdnav import (
     check_cases,
     crowdnav_scenario,
 )
-from zenav.sim.scenario import Scenario, dump_scenario, load_scenario
+from zenav.sim.scenario import dump_scenario, load_scenario
 
 __all__ = ["ENGINES", "SETTINGS", "Setting", "discomfort_steps", "run_crowd", "summarise"]
 
@@ -173,27 +174,6 @@ def summarise(records: Sequence[Record], planners: Sequence[str]) -> list[Row]:
                         unwarned=sum(r.get("hit") == UNWARNED for r in valid),
                         no_way_out=sum(r.get("hit") == NO_WAY_OUT for r in valid)))
     return rows
-
-
-UNWARNED = "unwarned"
-NO_WAY_OUT = "no way out"
-WAY_OUT = "way out"
-
-
-def collision_kind(scenario: Scenario, record: Record) -> str | None:
-    """What a collision left the robot: ``UNWARNED`` (no scan could have warned of the
-    human: :func:`zenav.bench.nav.no_warning`), ``NO_WAY_OUT`` (in view, but with a path
-    of its own that left no way out once a planner could act on it:
-    :func:`zenav.bench.escape.no_escape`, for humans blind to the robot only) or
-    ``WAY_OUT``; None for a run that did not end in a collision."""
-    from zenav.bench.escape import no_escape
-    from zenav.bench.nav import no_warning
-
-    if record.get("outcome") != "collision":
-        return None
-    if no_warning(scenario, record):
-        return UNWARNED
-    return NO_WAY_OUT if no_escape(scenario, record) else WAY_OUT
 
 
 def collisions_line(rows: Sequence[Row], visible: bool) -> str:

@@ -146,6 +146,24 @@ def no_warning(scenario: Scenario, record: dict[str, Any]) -> bool:
     return never_in_view(scenario, record) or appeared_at_contact(scenario, record)
 
 
+UNWARNED = "unwarned"
+NO_WAY_OUT = "no way out"
+WAY_OUT = "way out"
+
+
+def collision_kind(scenario: Scenario, record: dict[str, Any]) -> str | None:
+    """What a collision left the robot: ``UNWARNED`` (no scan could have warned of the
+    obstacle: :func:`no_warning`), ``NO_WAY_OUT`` (in view, but on a path of its own that
+    left no way out once a planner could act on it: :func:`zenav.bench.escape.no_escape`)
+    or ``WAY_OUT``; None for a run that did not end in a collision. ``bench nav`` and
+    ``bench crowd`` count their collisions by it."""
+    if record.get("outcome") != "collision":
+        return None
+    if no_warning(scenario, record):
+        return UNWARNED
+    return NO_WAY_OUT if no_escape(scenario, record) else WAY_OUT
+
+
 def summarise(records: list[dict[str, Any]], planners: Sequence[str],
               has_way: Callable[[str], bool] = lambda name: True,
               unwarned_hit: Callable[[dict[str, Any]], bool] = lambda record: False,
@@ -388,17 +406,14 @@ def run_nav(planners: Sequence[str], worlds: int, seed: int, out: Path,
     def has_way(name: str) -> bool:
         return name not in world_files or solvable(load_scenario(world_files[name]))
 
-    def unwarned_hit(record: dict[str, Any]) -> bool:
-        name = record["scenario"]
-        return (record["outcome"] == "collision" and name in world_files
-                and no_warning(load_scenario(world_files[name]), record))
-
-    def no_escape_hit(record: dict[str, Any]) -> bool:
-        name = record["scenario"]
-        return (record["outcome"] == "collision" and name in world_files
-                and no_escape(load_scenario(world_files[name]), record))
-
-    summaries, per_family = summarise(records, planners, has_way, unwarned_hit, no_escape_hit)
+    # Each collision judged once, its world read once.
+    kinds = {id(r): collision_kind(load_scenario(world_files[r["scenario"]]), r)
+             for r in records
+             if r["outcome"] == "collision" and r["scenario"] in world_files}
+    summaries, per_family = summarise(
+        records, planners, has_way,
+        unwarned_hit=lambda record: kinds.get(id(record)) == UNWARNED,
+        no_escape_hit=lambda record: kinds.get(id(record)) == NO_WAY_OUT)
     command = (f"zenav bench nav --planners {','.join(planners)} --worlds {worlds} "
                f"--seed {seed}" + ("" if tuple(families) == FAMILIES else
                                    f" --families {','.join(families)}")
