@@ -1502,7 +1502,10 @@ class Planner:
                    robot: tuple[float, float]) -> bool:
         """Whether a mover predicted at ``where`` (its disc grown to ``reach``) still walks
         toward the robot's place ``robot``, inside the window, on a line that passes it
-        closer than the clearance the planner keeps."""
+        closer than the clearance the planner keeps, and fast enough to get there within
+        ``safety_horizon``: a walker that has stopped out of view (at the end of its
+        walk, say) is still predicted at the few cm/s its track last showed, and must not
+        hold the robot for ever from metres away."""
         p = self.p
         dx, dy = robot[0] - where[0], robot[1] - where[1]
         vx, vy = ob.velocity
@@ -1511,6 +1514,9 @@ class Planner:
             return False  # standing, or past the robot
         if math.hypot(dx, dy) - ob.radius > p.window_radius:
             return False
+        gap = (dx * vx + dy * vy) / speed - reach - p.robot_radius
+        if gap > speed * p.safety_horizon:
+            return False  # too slow to reach the robot's place within the horizon
         across = abs(dx * vy - dy * vx) / speed
         return across <= reach + p.robot_radius + p.safety_margin
 

@@ -152,7 +152,8 @@ class Params(MissionParams, StopZoneParams):
         6.0, ge=0, description="a mover whose track is lost while it is out of the laser's "
         "view (beside or behind the robot, or hidden behind something nearer) is still "
         "predicted by the speed and safety stage from where it was last seen for up to "
-        "this long, s, and past it while it still walks at the robot; dropped at once "
+        "this long, s, and past it while it still walks at the robot fast enough to "
+        "reach it within safety_horizon; dropped at once "
         "when it should be in view and is not (0: never)"
     )
     drive_on_growth: float = Field(

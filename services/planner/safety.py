@@ -20,7 +20,8 @@ command as the robot would actually drive it:
 3. **Score** each roll-out: the cost of contact with a mover, discounted by how far ahead
    it is (``1 / (1 + t / tau)``), plus the way still to go from where it ends to a point
    on the global path the top speed could reach in the horizon, plus a small cost of
-   changing heading from the last choice (no dithering between equal options). Contact
+   changing heading from the last choice (no dithering between equal options; none for
+   a roll-out that arrives at the goal, which ends the run). Contact
    means coming within the robot radius + the mover's radius + half the safety margin
    + the growth; a pass within a further ``comfort`` m costs in proportion. Points the
    map holds (standing obstacles, inflated) are contact at once. A contact costs more
@@ -252,7 +253,15 @@ def choose(robot: Robot, proposal: tuple[float, float], movers: Movers, carrot: 
     total = cost + reach / max(robot.max_speed * s.horizon, 1e-9)
     if last_heading is not None and not np.isfinite(inside).any():
         # (not while a mover holds the robot: leaving it may need a half turn)
-        total = total + s.turn_cost * np.abs(wrap_angles(headings - last_heading))
+        turn = s.turn_cost * np.abs(wrap_angles(headings - last_heading))
+        if robot.goal is not None:
+            # A roll-out that arrives ends the run, so there is no dithering to guard
+            # against; near the goal the way left is worth too little to outweigh a
+            # turn, and a robot beside its goal would stand there for good.
+            arrives = np.hypot(xs[:, -1] - robot.goal[0],
+                               ys[:, -1] - robot.goal[1]) <= robot.arrive_within + 1e-9
+            turn = np.where(arrives, 0.0, turn)
+        total = total + turn
     best = int(np.argmin(total))
     culprit = int(who[0]) if who[0] >= 0 else None
     return Choice(wrap_angle(float(headings[best])), float(speeds[best]),

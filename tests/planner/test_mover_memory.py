@@ -102,3 +102,18 @@ def test_another_walker_near_its_predicted_place_does_not_make_it_seen_again() -
                scan_of((0.0, 0.0, 0.0), discs=[(1.0, 1.3, 0.2)]))
         p.step(behind, [track], 1.0, scan_of(behind))
         assert [ob.id for ob, _ in p.unseen] == remembered
+
+
+def test_a_walker_too_slow_to_reach_the_robot_is_forgotten_by_age() -> None:
+    # A walker stopped at the end of its walk, out of view, its track's last velocity a
+    # few cm/s toward the robot 3.5 m away: it would not reach the robot within the
+    # safety horizon, so it is forgotten after mover_memory like any other (crowd case
+    # 490 stood 5 s short of its goal for one). At 0.6 m/s it is kept.
+    for speed, remembered in ((0.1, []), (0.6, [7])):
+        p = planner(2.0)
+        walker = Obstacle(7, "dynamic", (3.5, 0.0), (-speed, 0.0), 0.2, (2, 2, 2, 2))
+        p.step((0.0, 0.0, 0.0), [walker], 0.0,
+               scan_of((0.0, 0.0, 0.0), discs=[(3.5, 0.0, 0.2)]))
+        facing_away = (0.0, 0.0, math.pi)
+        p.step(facing_away, [], 2.5, scan_of(facing_away))
+        assert [ob.id for ob, _ in p.unseen] == remembered

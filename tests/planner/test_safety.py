@@ -252,3 +252,25 @@ def test_what_lies_past_the_goal_does_not_hold_the_robot_short_of_it() -> None:
     assert safety.keeps_clear(with_goal, ahead, nobody, blocked, SETTINGS)
     choice = safety.choose(with_goal, ahead, nobody, carrot, blocked, math.pi, SETTINGS)
     assert choice.kept and choice.speed == 1.0
+
+
+def test_a_robot_beside_its_goal_turns_to_it_rather_than_stand() -> None:
+    """A crowd case (circle crossing, visible, 180 degrees, case 490) timed out 0.42 m from
+    the goal: the robot faced 75 degrees off it, a walker stood past it, and every fast
+    roll-out toward the goal swung past it into the map. The way left was worth 0.07 of a
+    cost, the turn to the goal 0.39, so standing won every cycle. A roll-out that arrives
+    ends the run and pays no turn cost."""
+    start = dataclasses.replace(robot(heading=math.pi / 2), goal=(0.4, 0.0), arrive_within=0.15)
+
+    def blocked(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64]
+                ) -> npt.NDArray[np.bool_]:
+        return np.asarray(np.any(np.hypot(xs - 1.2, ys) < 0.65, axis=1))
+
+    toward_goal = (0.0, 1.0)
+    assert not safety.keeps_clear(start, toward_goal, movers(), blocked, SETTINGS)
+    choice = safety.choose(start, toward_goal, movers(), np.array([0.4, 0.0]), blocked,
+                           math.pi / 2, SETTINGS)
+    assert choice.speed > 0.0
+    xs, ys, _ = safety.drive_out(start, np.array([choice.heading]), np.array([choice.speed]),
+                                 times())
+    assert math.hypot(xs[0, -1] - 0.4, ys[0, -1]) <= 0.15
