@@ -46,7 +46,8 @@ from zenav.sim.crowdnav import (
 )
 from zenav.sim.scenario import Scenario
 
-__all__ = ["Limits", "case_bound", "fastest_arrival", "humans_paths", "side_path"]
+__all__ = ["Limits", "agents_ignore_robot", "case_bound", "fastest_arrival", "humans_paths",
+           "side_path"]
 
 FloatArray = NDArray[np.float64]
 
@@ -65,11 +66,17 @@ class Limits:
     decel: float = DECEL
 
 
+def agents_ignore_robot(scenario: Scenario) -> bool:
+    """Whether no agent of ``scenario`` sees the robot: only then do the agents' paths not
+    depend on the robot's (one that sees it moves the others it meets)."""
+    return not any(o.is_agent and o.sees_robot for o in scenario.obstacles)
+
+
 def humans_paths(scenario: Scenario, duration: float, dt: float = TICK) -> FloatArray:
     """Every agent's centre at t = 0, dt, ..., duration: (ticks, agents, 2), m; NaN while an
     agent is absent. Only for agents that ignore the robot (their paths do not depend on
     it); ValueError if one sees it."""
-    if any(o.is_agent and o.sees_robot for o in scenario.obstacles):
+    if not agents_ignore_robot(scenario):
         raise ValueError(f"{scenario.name}: an agent sees the robot, so its path depends on "
                          "the robot's; the bound needs humans that ignore it (invisible)")
     crowd = Crowd(scenario)

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from zenav.bench.bound import humans_paths
+from zenav.bench.bound import agents_ignore_robot, humans_paths
 from zenav.services.geometry import wrap_angle
 from zenav.services.planner import safety
 from zenav.services.planner.params import Params
@@ -178,8 +178,7 @@ def no_escape(scenario: Scenario, record: dict[str, Any]) -> bool:
     if record.get("outcome") != "collision" or index is None or not trajectory:
         return False
     ob = scenario.obstacles[index]
-    if ob.is_static or (ob.is_agent and any(o.is_agent and o.sees_robot
-                                             for o in scenario.obstacles)):
+    if ob.is_static or (ob.is_agent and not agents_ignore_robot(scenario)):
         return False  # an agent that sees the robot moves the others it meets
     seen = first_in_view(scenario, record, index)
     if seen is None:
