@@ -6,6 +6,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -64,14 +65,55 @@ def by_stamp(path: Path, topic: str, message_type: type[Message]) -> dict[float,
     return {m.stamp: m.model_dump(exclude={"seq"}) for m in messages}
 
 
-def same_prefix(a: list[float], b: list[float]) -> list[float]:
-    """The stamps the two sequences share from their start, up to the first difference."""
-    prefix = []
-    for x, y in zip(a, b, strict=False):
-        if x != y:
-            break
-        prefix.append(x)
-    return prefix
+Outputs = dict[str, dict[float, Any]]
+"""One run's recorded outputs: topic -> stamp -> message."""
+
+
+@dataclass(frozen=True)
+class Comparison:
+    compared: int
+    """Outputs found equal in both runs."""
+    differs: float | None
+    """The stamp of an output that differs although nothing before it leaves a doubt that
+    both runs fed the stage the same chains."""
+    stopped: str
+    """Why the comparison ended."""
+
+
+def compare_stateful(live: Outputs, replayed: Outputs, stage: str,
+                     evidence: tuple[str, ...]) -> Comparison:
+    """Compare a stage that carries state from input to input (tracking, the planner).
+
+    A loaded host may lose a message in two places: the stage's newest-wins buffer drops
+    an input (its state then differs from there on, rightly), or the recorder misses a
+    sample the stage did answer (nothing differs). A stamp on any of the ``evidence``
+    topics (the stage's input, its output, or an output downstream of it) shows the stage
+    was fed that input. Outputs are compared in stamp order, from the first both runs
+    recorded (before it, a subscriber may not be heard yet in one run):
+    - an input fed in one run only ends the comparison;
+    - an output recorded in one run only leaves a doubt (dropped, or missed);
+    - an output that differs is a failure when no doubt came before it, else the end."""
+    answered = live[stage].keys() & replayed[stage].keys()
+    if not answered:
+        return Comparison(0, None, f"no {stage} stamp recorded in both runs")
+    seen = set().union(*(run[topic].keys() for run in (live, replayed) for topic in evidence))
+    doubt: float | None = None
+    compared = 0
+    for stamp in sorted(s for s in seen if s >= min(answered)):
+        fed = [any(stamp in run[topic] for topic in evidence) for run in (live, replayed)]
+        if fed[0] != fed[1]:
+            return Comparison(compared, None, f"the input at {stamp} reached one run only")
+        a, b = live[stage].get(stamp), replayed[stage].get(stamp)
+        if a is None or b is None:
+            doubt = stamp if doubt is None else doubt
+        elif a != b:
+            if doubt is None:
+                return Comparison(compared, stamp, f"the {stage} at {stamp} differ")
+            return Comparison(compared, None, f"they differ at {stamp}, after one run lacked "
+                              f"the {stage} at {doubt}")
+        else:
+            compared += 1
+    return Comparison(compared, None, "the runs ended")
 
 
 def on_router(source: str, target: Path, **changes: object) -> tuple[Deployed, str]:
@@ -174,28 +216,23 @@ def record_and_replay(tmp_path: Path) -> str | None:
     assert len(comparable) >= 20, (len(comparable), len(common))
     assert all(again["obstacles"][s] == recorded["obstacles"][s] for s in comparable)
     # Tracking and the planner carry state from chain to chain: the same outputs as long as
-    # each was fed the same inputs. A loaded host may drop a message at any stage (the
-    # newest-wins buffers), so each stage is compared up to the first input one run
-    # answered and the other did not.
-    # The first chains may be seen by one run only: a subscriber (the recorder live, a
-    # service in the replay) that is not yet heard when its first input comes. The
-    # comparison starts at the first chain both runs answered.
-    same = same_prefix(sorted(recorded["obstacles"]), sorted(again["obstacles"]))
-    for topic in ("tracks", "cmd_vel"):
-        first = next((s for s in same if s in recorded[topic] and s in again[topic]), None)
-        same = [s for s in same if first is not None and s >= first]
-        alike = [s for s in same if (s in recorded[topic]) == (s in again[topic])]
-        same = same_prefix(same, alike)
-        # Equal wherever both runs were fed the same, however few chains that is.
-        assert [again[topic].get(s) for s in same] == [recorded[topic].get(s) for s in same]
-        if len(same) < 10:
-            return (f"the {topic} were fed the same for {len(same)} chains only: obstacles "
-                    f"live {sorted(recorded['obstacles'])[:12]}, replayed "
-                    f"{sorted(again['obstacles'])[:12]}; {topic} live "
-                    f"{sorted(recorded[topic])[:12]}, replayed {sorted(again[topic])[:12]}")
+    # each was fed the same chains (see `compare_stateful`).
+    compared = len(scans)
+    for stage, evidence in (("tracks", ("obstacles", "tracks", "cmd_vel")),
+                            ("cmd_vel", ("tracks", "cmd_vel"))):
+        outcome = compare_stateful(recorded, again, stage, evidence)
+        assert outcome.differs is None, (
+            f"the {stage} differ at {outcome.differs} though both runs fed the same chains "
+            f"and answered each of them alike before it")
+        if outcome.compared < 10:
+            return (f"the {stage} were compared over {outcome.compared} chains only, "
+                    f"{outcome.stopped}: obstacles live {sorted(recorded['obstacles'])[:12]}, "
+                    f"replayed {sorted(again['obstacles'])[:12]}; {stage} live "
+                    f"{sorted(recorded[stage])[:12]}, replayed {sorted(again[stage])[:12]}")
+        compared = min(compared, outcome.compared)
     print(f"replay: {len(comparable)} of {len(scans)} scans answered after the same recent "
           f"scans gave the same chain ({len(common)} answered in both runs); tracks and "
-          f"commands identical over {len(same)} chains")
+          f"commands identical over {compared} chains")
     return None
 
 
