@@ -209,6 +209,7 @@ class Planner:
         self.speed_now = 0.0  # the speed the robot drove at over the last scan, m/s
         self.last_pose: tuple[float, float, float, float] | None = None  # x, y, heading, stamp
         self.safety_heading: float | None = None  # the safety stage's last heading
+        self.held_by_map = False  # this cycle, the safety stage stood for the map alone
         self.safety_settings = safety.Settings(
             horizon=params.safety_horizon, step=params.safety_step,
             margin=params.safety_margin, growth=params.safety_growth,
@@ -984,9 +985,13 @@ class Planner:
                 and self.clear_at_cruise(pose, target, walkers, ages)):
             speed, action = p.cruise_speed, "keep"
         self.safety_heading = None if not (movers or unseen) else self.safety_heading
+        self.held_by_map = False
         if p.speed_check and (movers or unseen) and c_hypot(*(target - robot)) > 1e-9:
             choice = self.speed_and_safety(pose, target, speed, walkers, path_target, ages)
             if not choice.kept:
+                # The command refused with no mover on it: its roll-out ran into what the
+                # map holds, and the robot stands for the map, not for a mover.
+                self.held_by_map = (choice.mover is None and choice.speed <= 0.0 < speed)
                 culprit = walkers[choice.mover] if choice.mover is not None else None
                 ahead = math.atan2(target[1] - robot[1], target[0] - robot[0])
                 turned = abs(wrap_angle(choice.heading - ahead))
@@ -1121,8 +1126,15 @@ class Planner:
                 # has come to hold since it was planned (a wall's end seen late): the
                 # local layer saw no threat on it, so it is planned again on the map.
                 self.replan_asked = "blocked within the window"
+            if self.held_by_map and stamp - self.last_replan >= p.replan_period:
+                # The safety stage stands because the way along the path passes within
+                # the inflation of what the map holds (a path planned before a box beside
+                # it was seen, through a gap it leaves too narrow): the path's own check
+                # asks only that the robot's disc pass, so it is planned again on the
+                # inflated map, once per ``replan_period``.
+                self.replan_asked = "the map holds the way ahead"
             waiting = (decision.action in ("stop", "slow", "give_way")
-                       and decision.kind == "dynamic")
+                       and decision.kind == "dynamic" and not self.held_by_map)
             # Walled in: the goal is cut off by walls seen (the wall memory), so gains
             # along a path through forgotten walls are no progress: the steps follow one
             # another at once instead of after a stall (and progress does not reset them).

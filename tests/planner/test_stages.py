@@ -806,3 +806,36 @@ def test_a_robot_at_most_the_look_ahead_per_second_slows_as_before_in_a_bend() -
     near = math.dist(d.target, pose[:2])
     assert near < 0.9 and d.v == pytest.approx(near * math.cos(
         math.atan2(d.target[1] - 3.0, d.target[0] - 5.0)))
+
+
+def test_a_path_that_grazes_a_box_the_safety_stage_refuses_is_planned_again_at_once() -> None:
+    """A path planned before a box beside it was seen keeps the robot's disc off the box
+    (the path's own check) but runs within the inflation of it, where the safety stage's
+    roll-outs touch the map: with a walker ahead to check, the robot stood for the map
+    while the walker was its only named reason, and the stall was taken for waiting on
+    a mover (12 s in a corridor half blocked by a box, 7 December). Now the path is
+    planned again at once, clear of the box's inflation."""
+    # A 0.8 m corridor at 0.4 m/s, a box on its lower wall (the scene of 7 December):
+    # the disc clears the box's cells, its inflation does not, and there is no room to
+    # step aside within the roll-outs' reach.
+    box_top = 2.8
+    grazed = [(0.0, 3.6, 9.0, 3.8), (0.0, 2.2, 9.0, 2.4), (2.3, 2.4, 2.9, box_top)]
+    walker = mover(7, 4.0, 3.0, 0.2, 0.0)  # ahead, slower, the same way: (g)
+    p = planner(cruise_speed=0.4)
+    d = None
+    for k in range(12):
+        d = p.step(POSE, [walker], k * 0.1, scan_of(POSE, boxes=grazed))
+        if p.held_by_map:
+            break
+    assert d is not None and d.speed == 0.0 and p.held_by_map
+    assert p.replan_asked == "the map holds the way ahead"
+    p.step(POSE, [walker], 1.3, scan_of(POSE, boxes=grazed))
+    assert p.plan is not None and p.plan.found and p.plan.reason == "the map holds the way ahead"
+    assert p.path is not None
+    inflation = p.p.robot_radius + p.p.safety_margin
+    along = np.linspace(0.0, 1.0, 200)[:, None]
+    points = np.vstack([a + along * (b - a) for a, b in itertools.pairwise(p.path)])
+    x0, y0, x1, y1 = grazed[-1]
+    to_box = np.hypot(np.clip(points[:, 0], x0, x1) - points[:, 0],
+                      np.clip(points[:, 1], y0, y1) - points[:, 1])
+    assert to_box.min() >= inflation - p.p.map_resolution  # (a cell's rounding)
