@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +42,7 @@ from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import (
     backing_toward,
     command_toward,
+    off_discs,
     reach_along,
     room_near,
 )
@@ -137,6 +138,13 @@ class Detour:
     letter: ScenarioLetter
     side: int  # +1: passes the obstacle on its left (robot turns left), -1: right
     kind: ObstacleKind = "new"  # the obstacle's type when the detour was chosen
+
+
+def mover_discs(obstacles: Sequence[Obstacle]) -> list[tuple[float, float, float]]:
+    """(x, y, radius) of the tracks typed dynamic: the discs whose returns the map and the
+    look for room at the goal leave out."""
+    return [(o.position[0], o.position[1], o.radius) for o in obstacles
+            if o.kind == "dynamic"]
 
 
 def should_be_seen(scan: ScanData, point: tuple[float, float], radius: float) -> bool:
@@ -1098,7 +1106,7 @@ class Planner:
         # graze them, and a radius a little short would leave marks in a mover's wake).
         self.update_map(pose, tracked, scan, stamp)
         self.settle_goal(robot)
-        self.look_for_room(robot, pose[2], scan)
+        self.look_for_room(robot, pose[2], scan, tracked)
         self.on_last_stretch = self.last_stretch(robot, pose[2], scan)
         self.update_path(robot, stamp)
         decision = self.recover(pose, stamp, scan)
@@ -1565,9 +1573,7 @@ class Planner:
                 max_size=p.map_max_size)
         if scan is None:
             return
-        movers = [(o.position[0], o.position[1], o.radius) for o in obstacles
-                  if o.kind == "dynamic"]
-        self.costmap.update(scan, stamp, movers)
+        self.costmap.update(scan, stamp, mover_discs(obstacles))
 
     # -- stage: the global path --------------------------------------------------------
 
@@ -1736,7 +1742,8 @@ class Planner:
         elif self.no_room and (self.plan is None or self.plan.found):
             self.plan = GlobalPlan(np.empty((0, 2)), math.inf, NO_ROOM)
 
-    def look_for_room(self, robot: Vec, heading: float, scan: ScanData | None) -> None:
+    def look_for_room(self, robot: Vec, heading: float, scan: ScanData | None,
+                      obstacles: Sequence[Obstacle] = ()) -> None:
         """Beyond the paper (``final_approach_speed``), once a scan: when the goal lies
         beside what the laser sees (within the window and its view, not clear on the map,
         as for ``last_stretch``), whether no point within the run's tolerance of it
@@ -1744,7 +1751,8 @@ class Planner:
         (``follow.room_near``): no robot the stop zone lets come that near a return
         stands within the tolerance. Kept in ``no_room`` until the goal is seen again
         (recovery gives the goal up on it, after a round of steps); a goal in the open
-        has room."""
+        has room. The returns on the movers (tracks typed dynamic in ``obstacles``) are
+        left out as the map leaves them out: a mover walking over the goal leaves it."""
         p = self.p
         if self.costmap is None or c_hypot(*(self.mission_goal - robot)) > p.window_radius:
             return
@@ -1755,8 +1763,9 @@ class Planner:
             return
         assert scan is not None
         # (rings 1 cm apart, or a 25th of a tolerance over 0.25 m: at most ~2000 points)
+        returns = off_discs(scan.returns, mover_discs(obstacles), p.map_resolution)
         self.no_room = not room_near((float(self.mission_goal[0]), float(self.mission_goal[1])),
-                                     scan.returns, self._approach_clearance(),
+                                     returns, self._approach_clearance(),
                                      p.goal_tolerance, step=max(0.01, p.goal_tolerance / 25))
         self.room_seen = not self.no_room
 

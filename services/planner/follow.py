@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -95,6 +96,19 @@ def room_near(goal: tuple[float, float], points: npt.NDArray[np.float64], cleara
     cx, cy = gx + ox, gy + oy
     gaps = np.hypot(cx[:, None] - near[None, :, 0], cy[:, None] - near[None, :, 1])
     return bool((gaps.min(axis=1) >= clearance).any())
+
+
+def off_discs(points: npt.NDArray[np.float64], discs: Sequence[tuple[float, float, float]],
+              slack: float) -> npt.NDArray[np.float64]:
+    """The rows of ``points`` (n, 2) farther than ``slack`` from every disc (x, y, radius)
+    of ``discs``: the rule by which the map's ray tracing leaves a mover's returns out
+    (``_loops.trace_scan``)."""
+    if not discs or points.shape[0] == 0:
+        return points
+    d = np.asarray(discs, dtype=np.float64)
+    gaps = np.hypot(points[:, None, 0] - d[None, :, 0],
+                    points[:, None, 1] - d[None, :, 1]) - d[None, :, 2]
+    return points[(gaps >= slack).all(axis=1)]
 
 
 @functools.lru_cache(maxsize=8)
