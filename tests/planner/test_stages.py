@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from tests.planner.scans import scan_of
+from zenav.schemas.messages import ObstacleKind
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
 from zenav.services.planner.decide import (
@@ -703,7 +704,7 @@ def test_a_goal_with_no_room_for_the_robot_and_its_zone_ends_in_unreachable() ->
 
 
 @pytest.mark.parametrize("kind", ["static", "dynamic"])
-def test_movers_round_the_goal_leave_room_there(kind: str) -> None:
+def test_movers_round_the_goal_leave_room_there(kind: ObstacleKind) -> None:
     """The look for room at the goal counted the returns of movers: "no room", the
     recovery steps one after another at once, and the goal given up while two slow
     discs walked past it (head-on-142000, a seed not run before: given up at 21 s, the

@@ -3,14 +3,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from tests.integration.test_record_replay import compare_stateful
 
 EVIDENCE = ("obstacles", "tracks", "cmd_vel")
 
 
-def run(obstacles: list[float], tracks: dict[float, str],
+def run(obstacles: list[float], tracks: Mapping[float, object],
         cmd_vel: list[float] | None = None) -> dict[str, dict[float, object]]:
-    return {"obstacles": dict.fromkeys(obstacles), "tracks": tracks,
+    return {"obstacles": dict.fromkeys(obstacles), "tracks": dict(tracks),
             "cmd_vel": dict.fromkeys(cmd_vel if cmd_vel is not None else list(tracks))}
 
 
