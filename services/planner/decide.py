@@ -1743,7 +1743,7 @@ class Planner:
             self.plan = GlobalPlan(np.empty((0, 2)), math.inf, NO_ROOM)
 
     def look_for_room(self, robot: Vec, heading: float, scan: ScanData | None,
-                      obstacles: Sequence[Obstacle] = ()) -> None:
+                      obstacles: Sequence[Obstacle]) -> None:
         """Beyond the paper (``final_approach_speed``), once a scan: when the goal lies
         beside what the laser sees (within the window and its view, not clear on the map,
         as for ``last_stretch``), whether no point within the run's tolerance of it
