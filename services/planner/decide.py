@@ -993,7 +993,6 @@ class Planner:
                 and self.clear_at_cruise(pose, target, walkers, ages)):
             speed, action = p.cruise_speed, "keep"
         self.safety_heading = None if not (movers or unseen) else self.safety_heading
-        self.held_by_map = False
         if p.speed_check and (movers or unseen) and c_hypot(*(target - robot)) > 1e-9:
             choice = self.speed_and_safety(pose, target, speed, walkers, path_target, ages)
             if not choice.kept:
@@ -1117,6 +1116,7 @@ class Planner:
             self.recovery.finish(stamp, self.to_go(robot))
             decision = None
         if decision is None:
+            self.held_by_map = False  # set by this cycle's local layer, if it runs
             decision = self.hold_aside(pose, obstacles, stamp)
             if (decision is not None and decision.speed <= 0.0
                     and self.walked_into(pose, obstacles)):
