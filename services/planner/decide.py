@@ -199,6 +199,7 @@ class Planner:
         self.lengths: Vec | None = None  # the path's arc length at each vertex, m
         self.plan_count = 0  # bumped at every new path
         self.last_replan = -math.inf
+        self.last_compared = -math.inf  # when a detour was last weighed against the map
         self.replan_asked: str | None = None  # why the next cycle must re-plan
         self.recovery = Recovery(RecoverySettings(
             progress_distance=params.progress_distance,
@@ -623,8 +624,11 @@ class Planner:
         when it is blocked beyond the window): plan the path again on the map now,
         rather than a detour on the 0.5 m boxes, when the paper's detour would take the
         robot into what the map holds (the boxes can close a narrow gap and send the
-        robot along a wall toward its end). A detour the map agrees with is kept, as in
-        the paper. At most once per ``replan_period``; whether a path was found."""
+        robot along a wall toward its end), or when the map knows a way shorter than any
+        through the detour's sub-target (``_map_way_shorter``: a door in the wall the
+        detour runs along). Otherwise the paper's detour is kept. Asked with no detour
+        under way, and on one when a (b) blocks the way to its sub-target. At most once
+        per ``replan_period``; whether a path was found."""
         p = self.p
         if self.costmap is None or not p.use_map or self.path is None:
             return False
@@ -638,12 +642,29 @@ class Planner:
         trial = self.plan_detour(robot, min(mapped, key=lambda a: a.robot_distance),
                                  obstacles, fast=False, on_map=False)
         self.sides = sides
+        plan = None
         if trial is not None and self._disc_clear(self._leg(robot, trial.subtarget)):
-            return False
+            plan = self._map_way_shorter(robot, trial.subtarget, stamp)
+            if plan is None:
+                return False
         count = self.plan_count
         self.replan_asked = "mapped obstacle on the path"
-        self.update_path(robot, stamp)
+        self.update_path(robot, stamp, plan)
         return self.plan_count != count
+
+    def _map_way_shorter(self, robot: Vec, via: Vec, stamp: float) -> GlobalPlan | None:
+        """The map's path to the goal, when it is shorter by more than ``path_deviation``
+        than the straight legs robot -> ``via`` -> goal, the least any way through a
+        detour's sub-target ``via`` can take; else None. Planned at most once per
+        ``replan_period`` (a detour the map does not beat stays weighed that long)."""
+        p = self.p
+        assert self.costmap is not None
+        if stamp - self.last_compared < p.replan_period:
+            return None
+        self.last_compared = stamp
+        plan = plan_path(self.costmap, robot, self.goal, "mapped obstacle on the path")
+        least = c_hypot(*(via - robot)) + c_hypot(*(self.goal - via))
+        return plan if plan.found and plan.length + p.path_deviation < least else None
 
     # -- responses ---------------------------------------------------------------------
 
@@ -895,9 +916,9 @@ class Planner:
         clear = self._map_clear(robot, target, to_goal=self.detour is None)
         threats = self._threats(notes, clear, stamp, robot, target, self.detour is None,
                                 last_stretch)
-        if self.detour is None and self._replan_round_mapped(robot, path_target, threats,
-                                                             in_window, stamp):
+        if self._replan_round_mapped(robot, path_target, threats, in_window, stamp):
             # The path now goes round what the map holds: judge the way along it again.
+            self.detour = None
             path_target = target = self.path_target(robot, self._statics(in_window))
             notes = self._assess_all(robot, target, in_window, 0.0, to_goal=True)
             clear = self._map_clear(robot, target, to_goal=True)
@@ -1680,8 +1701,9 @@ class Planner:
             path[-1] = self.goal
             self._set_path(path, "goal settled")
 
-    def update_path(self, robot: Vec, stamp: float) -> None:
-        """Plan the global path on the map when it is needed (see ``replan_reason``)."""
+    def update_path(self, robot: Vec, stamp: float, planned: GlobalPlan | None = None) -> None:
+        """Plan the global path on the map when it is needed (see ``replan_reason``);
+        ``planned``: the plan a caller has just made on this map for that reason."""
         if self.costmap is None:
             return
         reason = self.replan_reason(robot, stamp)
@@ -1689,7 +1711,8 @@ class Planner:
             return
         self.replan_asked = None
         self.last_replan = stamp
-        plan = plan_path(self.costmap, robot, self.goal, reason)
+        plan = planned if planned is not None else plan_path(self.costmap, robot, self.goal,
+                                                             reason)
         if not plan.found and plan.reason == "goal occupied" and self.on_last_stretch:
             # The goal's cell holds the wall it lies against, but the scan has room
             # within the tolerance along the straight way: that is the path.

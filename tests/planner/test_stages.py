@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.planner.scans import scan_of
+from tests.planner.scans import scan_of, wall_with_gap
 from zenav.schemas.messages import ObstacleKind
 from zenav.services.motor_bridge.command_filter import CommandFilter
 from zenav.services.motor_bridge.params import Params as BridgeParams
@@ -473,6 +473,27 @@ def test_a_mapped_wall_whose_cell_boxes_close_a_narrow_gap_is_passed_through_the
                 if a[0] < 5.15 <= b[0]]
     assert len(crossing) == 1 and 3.9 < crossing[0][1][1] < 4.72  # through the gap
     assert x >= 5.8  # and on past the wall
+
+
+def test_a_detour_along_a_wall_gives_way_to_the_map_s_path_through_its_door() -> None:
+    """A long wall across the way with a 0.9 m door just off the line, all of it in the
+    map. A detour whose sub-target lies 3 m down the wall is beaten by the map's path
+    through the door (shorter than any way through that sub-target), and the path is
+    planned through the door; a sub-target beside the door is not beaten. The map is
+    weighed against a detour at most once per ``replan_period``."""
+    wall = wall_with_gap(5.0, 3.3, 4.2)
+    p = planner()
+    for k in range(20):
+        p.step(POSE, [], k * 0.1, scan_of(POSE, boxes=wall))
+    robot = np.array([4.4, 3.0])
+    assert p._map_way_shorter(robot, np.array([4.6, 3.75]), 2.0) is None  # by the door
+    assert p._map_way_shorter(robot, np.array([4.4, 0.0]), 2.5) is None  # too soon
+    plan = p._map_way_shorter(robot, np.array([4.4, 0.0]), 3.0)
+    assert plan is not None and plan.found
+    crossing = [(a, b) for a, b in itertools.pairwise(plan.points) if a[0] < 5.0 <= b[0]]
+    assert len(crossing) == 1
+    (ax, ay), (bx, by) = crossing[0]
+    assert 3.3 < ay + (by - ay) * (5.0 - ax) / (bx - ax) < 4.2  # through the door
 
 
 @pytest.mark.parametrize("goal_x", [4.2, 4.4, 4.5])
