@@ -458,14 +458,40 @@ class Planner:
         if (p.final_approach_speed <= 0.0 or scan is None or self.costmap is None
                 or not p.use_map):
             return False
-        offset = self.mission_goal - robot
-        if c_hypot(*offset) > p.window_radius:
-            return False
         if goal_clear(self.costmap, self.mission_goal, p.robot_radius + p.safety_margin / 2):
             return False  # a goal in the open: the paper's tests decide
+        return self._goal_in_view(robot, heading, scan)
+
+    def _goal_in_view(self, robot: Vec, heading: float, scan: ScanData) -> bool:
+        """Whether the goal lies within the window and the laser's field of view."""
+        offset = self.mission_goal - robot
+        if c_hypot(*offset) > self.p.window_radius:
+            return False
         bearing = wrap_angle(math.atan2(offset[1], offset[0]) - heading)
         angle_max = scan.angle_min + scan.angle_increment * (scan.ranges.shape[0] - 1)
         return bool(scan.angle_min <= bearing <= angle_max)
+
+    def room_again(self, pose: tuple[float, float, float], tracked: list[Obstacle],
+                   scan: ScanData | None, stamp: float) -> bool:
+        """Beyond the paper: a goal given up for want of room at it (``NO_ROOM``) is kept
+        in view. Whatever stood there may leave: a mover too slow for the tracker to see
+        it move is typed static, and its returns count. While given up the map is kept
+        up to date, and once the laser sees the goal (within the window and the field of
+        view) with room at it (clear on the map, or room between the scan's returns:
+        ``look_for_room``), navigation starts again with the recovery steps afresh, and
+        True is returned. ``given_up`` turns the robot to face the goal meanwhile."""
+        if self.plan is None or self.plan.reason != NO_ROOM or scan is None:
+            return False
+        self.update_map(pose, tracked, scan, stamp)
+        robot = np.array(pose[:2], dtype=np.float64)
+        if not self._goal_in_view(robot, pose[2], scan):
+            return False
+        self.look_for_room(robot, pose[2], scan, tracked)
+        if self.no_room:
+            return False
+        self.recovery = Recovery(self.recovery.s)
+        self.replan_asked = "room at the goal again"
+        return True
 
     def _arrived_beside(self, robot: Vec, heading: float, scan: ScanData | None) -> bool:
         """On the last stretch (``last_stretch``) and within the run's tolerance of its
@@ -1118,7 +1144,7 @@ class Planner:
                 or self._arrived_beside(robot, pose[2], scan)):
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
-        if self.recovery.unreachable:
+        if self.recovery.unreachable and not self.room_again(pose, tracked, scan, stamp):
             return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
 
         # The map leaves out the returns on the movers' visible surfaces: the tracks'
@@ -1220,7 +1246,14 @@ class Planner:
         the robot stands (the least move that keeps clear), and the robot takes it this
         cycle (action ``give_way``); it stands again once the walker has passed."""
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
-        standing = Decision(0.0, 0.0, goal_xy, "a", "unreachable", None, None, 0.0)
+        omega = 0.0
+        if self.plan is not None and self.plan.reason == NO_ROOM:
+            # Given up for want of room: it turns in place to keep the goal in view
+            # (``room_again``), the laser's middle beam on it.
+            error = wrap_angle(math.atan2(goal_xy[1] - pose[1], goal_xy[0] - pose[0])
+                               - pose[2])
+            omega = max(-self.p.max_omega, min(self.p.max_omega, self.p.heading_gain * error))
+        standing = Decision(0.0, omega, goal_xy, "a", "unreachable", None, None, 0.0)
         walkers = self._walkers_at(pose, obstacles)
         if not walkers or not self._walks_into(pose, walkers):
             return standing

@@ -724,6 +724,39 @@ def test_a_goal_with_no_room_for_the_robot_and_its_zone_ends_in_unreachable() ->
     assert t < 30.0  # one round of the steps, not the stall watch's rounds
 
 
+def test_a_goal_given_up_for_want_of_room_is_taken_up_again_once_it_has_room() -> None:
+    # What left no room stood there for a while and then went (bench nav's
+    # mixed-150021: a 0.05 m/s disc, too slow to be seen moving, on the goal when the
+    # robot came; given up at 22 s, the robot then stood 130 s beside a free goal).
+    pose = (7.0, 3.0, 0.0)
+    p = planner(spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    _, t = until_unreachable(p, pose, wall_beyond_goal(0.03), 60.0)
+    for _ in range(20):  # while it stands there the goal stays given up
+        t = round(t + 0.1, 6)
+        d = p.step(pose, [], t, scan_of(pose, boxes=wall_beyond_goal(0.03)))
+        assert (d.action, d.v) == ("unreachable", 0.0)
+    actions = []
+    for _ in range(30):  # gone: the laser sees the goal with room at it
+        t = round(t + 0.1, 6)
+        d = p.step(pose, [], t, scan_of(pose))
+        actions.append(d.action)
+    assert "unreachable" not in actions[1:] and not p.recovery.unreachable
+    assert not p.no_room and p.plan is not None and p.plan.found
+    assert d.v > 0.0 and d.target == (8.0, 3.0)  # on its way to the goal
+
+
+def test_a_robot_that_gave_a_goal_up_for_want_of_room_turns_to_keep_it_in_view() -> None:
+    pose = (7.0, 3.0, 0.0)
+    p = planner(spin_deg=10.0, wait_time=1.0, backup_distance=0.0)
+    _, t = until_unreachable(p, pose, wall_beyond_goal(0.03), 60.0)
+    away = (7.0, 3.0, 3.0)  # the goal almost straight behind
+    d = p.step(away, [], t + 0.1, scan_of(away, boxes=wall_beyond_goal(0.03)))
+    assert (d.action, d.v) == ("unreachable", 0.0)
+    assert d.omega == -p.p.max_omega  # the short way round to face it
+    d = p.step(pose, [], t + 0.2, scan_of(pose, boxes=wall_beyond_goal(0.03)))
+    assert (d.action, d.v, d.omega) == ("unreachable", 0.0, 0.0)  # facing it: stands
+
+
 @pytest.mark.parametrize("kind", ["static", "dynamic"])
 def test_movers_round_the_goal_leave_room_there(kind: ObstacleKind) -> None:
     """The look for room at the goal counted the returns of movers: "no room", the
