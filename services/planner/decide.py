@@ -474,8 +474,9 @@ class Planner:
     def room_again(self, pose: tuple[float, float, float], tracked: list[Obstacle],
                    scan: ScanData | None, stamp: float) -> bool:
         """Beyond the paper: a goal given up for want of room at it (``NO_ROOM``) is kept
-        in view. Whatever stood there may leave: a mover too slow for the tracker to see
-        it move is typed static, and its returns count. While given up the map is kept
+        in view. Whatever stood there may leave: a slow mover kept as a standing obstacle
+        while it was out of view (as the recovery's spin turned the laser away), or one
+        too slow to be seen moving. While given up the map is kept
         up to date, and once the laser sees the goal (within the window and the field of
         view) with room at it (clear on the map, or room between the scan's returns:
         ``look_for_room``), navigation starts again with the recovery steps afresh, and
