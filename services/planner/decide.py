@@ -471,23 +471,23 @@ class Planner:
         angle_max = scan.angle_min + scan.angle_increment * (scan.ranges.shape[0] - 1)
         return bool(scan.angle_min <= bearing <= angle_max)
 
-    def room_again(self, pose: tuple[float, float, float], tracked: list[Obstacle],
-                   scan: ScanData | None, stamp: float) -> bool:
+    def _given_up_for_room(self) -> bool:
+        """Whether the goal was given up for want of room at it (``NO_ROOM``)."""
+        return self.plan is not None and self.plan.reason == NO_ROOM
+
+    def room_again(self, robot: Vec, heading: float, scan: ScanData | None,
+                   tracked: list[Obstacle]) -> bool:
         """Beyond the paper: a goal given up for want of room at it (``NO_ROOM``) is kept
         in view. Whatever stood there may leave: a slow mover kept as a standing obstacle
         while it was out of view (as the recovery's spin turned the laser away), or one
-        too slow to be seen moving. While given up the map is kept
-        up to date, and once the laser sees the goal (within the window and the field of
-        view) with room at it (clear on the map, or room between the scan's returns:
+        too slow to be seen moving. While given up the map is kept up to date (``step``),
+        and once the laser sees the goal (within the window and the field of view) with
+        room at it (clear on the map, or room between the scan's returns:
         ``look_for_room``), navigation starts again with the recovery steps afresh, and
         True is returned. ``given_up`` turns the robot to face the goal meanwhile."""
-        if self.plan is None or self.plan.reason != NO_ROOM or scan is None:
+        if scan is None or not self._goal_in_view(robot, heading, scan):
             return False
-        self.update_map(pose, tracked, scan, stamp)
-        robot = np.array(pose[:2], dtype=np.float64)
-        if not self._goal_in_view(robot, pose[2], scan):
-            return False
-        self.look_for_room(robot, pose[2], scan, tracked)
+        self.look_for_room(robot, heading, scan, tracked)
         if self.no_room:
             return False
         self.recovery = Recovery(self.recovery.s)
@@ -1145,13 +1145,18 @@ class Planner:
                 or self._arrived_beside(robot, pose[2], scan)):
             self.detour = None
             return self._record(Decision(0.0, 0.0, goal_xy, "a", "goal", None, None, 0.0))
-        if self.recovery.unreachable and not self.room_again(pose, tracked, scan, stamp):
+        # A goal given up for want of room is watched (``room_again``); one given up
+        # for want of a way is not.
+        watching = self.recovery.unreachable and self._given_up_for_room()
+        if self.recovery.unreachable and not watching:
             return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
 
         # The map leaves out the returns on the movers' visible surfaces: the tracks'
         # own discs, centred on those surfaces, cover them (the footprints' discs only
         # graze them, and a radius a little short would leave marks in a mover's wake).
         self.update_map(pose, tracked, scan, stamp)
+        if watching and not self.room_again(robot, pose[2], scan, tracked):
+            return self._record(self.guard_stop_zone(self.given_up(pose, obstacles), pose, scan))
         self.settle_goal(robot)
         self.look_for_room(robot, pose[2], scan, tracked)
         self.on_last_stretch = self.last_stretch(robot, pose[2], scan)
@@ -1248,12 +1253,11 @@ class Planner:
         cycle (action ``give_way``); it stands again once the walker has passed."""
         goal_xy = (float(self.goal[0]), float(self.goal[1]))
         omega = 0.0
-        if self.plan is not None and self.plan.reason == NO_ROOM:
-            # Given up for want of room: it turns in place to keep the goal in view
-            # (``room_again``), the laser's middle beam on it.
-            error = wrap_angle(math.atan2(goal_xy[1] - pose[1], goal_xy[0] - pose[0])
-                               - pose[2])
-            omega = max(-self.p.max_omega, min(self.p.max_omega, self.p.heading_gain * error))
+        if self._given_up_for_room():
+            # It turns in place to keep the goal in view (``room_again``), the laser's
+            # middle beam on it.
+            _, omega = command_toward(pose[0], pose[1], pose[2], goal_xy, 0.0,
+                                      self.p.heading_gain, self.p.max_omega)
         standing = Decision(0.0, omega, goal_xy, "a", "unreachable", None, None, 0.0)
         walkers = self._walkers_at(pose, obstacles)
         if not walkers or not self._walks_into(pose, walkers):
