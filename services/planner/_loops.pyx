@@ -703,8 +703,9 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
     the roll-out's first contact (inf: none) and into ``who`` its mover (the first by
     index at that time; -1: none). ``inside[j]``: the robot's distance now to mover j
     when its clearance holds the robot now (its clearance is capped there, and a contact
-    costs its depth alone), else inf. (``tau``, and ``comfort`` when above 0, are never
-    0: ``Settings`` come from the planner's parameters.)"""
+    costs 1 + 10 x its depth: no less than any pass outside it), else inf. (``tau``, and
+    ``comfort`` when above 0, are never 0: ``Settings`` come from the planner's
+    parameters.)"""
     cdef Py_ssize_t n = xs.shape[0], m = radii.shape[0], steps = times.shape[0]
     cdef Py_ssize_t i, j, k, first_k
     cdef double px, py, gap, clearance, near, depth, cost, largest
@@ -725,7 +726,7 @@ def contacts(const double[:, ::1] xs, const double[:, ::1] ys, const double[::1]
                 gap = hypot(xs[i, k] - px, ys[i, k] - py) - clearance
                 if gap < 0.0:
                     depth = min(max(-gap / clearance, 0.0), 1.0)
-                    cost = 10.0 * (depth if held else 1.0 + depth)
+                    cost = 1.0 + 10.0 * depth if held else 10.0 * (1.0 + depth)
                     if k < first_k:
                         first_k = k
                         who[i] = j

@@ -202,10 +202,14 @@ def contact_costs(xs: Vec, ys: Vec, times: Vec, movers: Movers, robot_radius: fl
 
     A mover whose clearance already holds the robot (``inside``, with
     ``Settings.from_inside``) has that clearance capped at their distance now, and a
-    contact with it costs 10 x its depth, with no floor: only coming closer counts, by
-    how much. Without the cap every candidate touches it from its first step, the first
-    step's cost is about the same for all of them, and a robot standing while the mover
-    walks in can score as well as one that leaves.
+    contact with it costs 1 + 10 x its depth: only coming closer counts, by how much.
+    Without the cap every candidate touches it from its first step, the first step's
+    cost is about the same for all of them, and a robot standing while the mover walks
+    in can score as well as one that leaves. The 1 keeps the cost rising as the gap
+    shrinks: a contact costs no less than a pass just outside the capped clearance
+    (``comfort``'s cost is at most 1). With 10 x the depth alone, a robot standing as a
+    walker came 4 cm closer paid less than one stepping away along the clearance's edge,
+    and stood (``bench nav``, unseen-walkers-doorway-152015).
     The loop over roll-outs, movers and steps is compiled (``_loops.contacts``)."""
     n, m = xs.shape[0], len(movers)
     if m == 0:

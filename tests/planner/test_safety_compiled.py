@@ -41,7 +41,8 @@ def numpy_contact_costs(xs: Vec, ys: Vec, times: Vec, movers: safety.Movers,
     touch: npt.NDArray[np.bool_] = np.asarray(gap < 0.0) & driven[:, None, :]
     near = np.clip(1.0 - gap / s.comfort, 0.0, 1.0) if s.comfort > 0 else touch * 1.0
     depth = np.clip(-gap / clearance[None], 0.0, 1.0)
-    cost_mk = np.where(touch, 10.0 * np.where(held[None, :, None], depth, 1.0 + depth),
+    cost_mk = np.where(touch, np.where(held[None, :, None], 1.0 + 10.0 * depth,
+                                       10.0 * (1.0 + depth)),
                        near) * weight  # (n, m, k)
     cost_mk = np.where(driven[:, None, :], cost_mk, -np.inf)
     cost = cost_mk.max(axis=2).sum(axis=1)
