@@ -214,24 +214,24 @@ def test_a_robot_inside_a_walkers_clearance_leaves_instead_of_standing() -> None
 
 def test_inside_a_clearance_a_contact_costs_more_than_any_pass_outside_it() -> None:
     # unseen-walkers-doorway-152015 of `zenav bench nav --seed 152000`, reduced: a walker
-    # whose clearance holds the robot (0.40 m apart, clearance 0.45 m) comes 4 cm closer
-    # in the next step if the robot stands; stepping 5 cm away keeps it 1 cm outside the
+    # whose clearance holds the robot (0.40 m apart, clearance 0.45 m) comes 2 cm closer
+    # in the next step if the robot stands; stepping 3 cm away keeps it 1 cm outside the
     # capped clearance, within ``comfort``. Standing must cost more: with a contact cost
-    # of 10 x its depth alone (0.5 here) it cost less than the near pass (0.98), and the
-    # robot stood and was walked into.
+    # of 10 x its depth alone (0.5 here, before the time weight) it cost less than the
+    # near pass (0.98), and the robot stood and was walked into.
     s = dataclasses.replace(SETTINGS, growth=0.0, from_inside=True)
-    walker = safety.Movers(np.array([[0.4, 0.0]]), np.array([[-0.2, 0.0]]),
+    walker = safety.Movers(np.array([[0.4, 0.0]]), np.array([[-0.1, 0.0]]),
                            np.array([0.2]), np.array([0.2]))
     t = np.array([0.2])
     inside = safety.holding((0.0, 0.0), walker, 0.2, s)
     assert inside[0] == pytest.approx(0.4)  # held, its clearance capped at 0.4 m
-    xs, ys = np.array([[0.0], [-0.05]]), np.array([[0.0], [0.0]])  # stand; step away
+    xs, ys = np.array([[0.0], [-0.03]]), np.array([[0.0], [0.0]])  # stand; step away
     cost, first_t, _ = safety.contact_costs(xs, ys, t, walker, 0.2, s, inside)
     assert first_t[0] == pytest.approx(0.2) and math.isinf(first_t[1])
     weight = 1.0 / (1.0 + 0.2 / s.tau)
     assert cost[1] == pytest.approx((1.0 - 0.01 / s.comfort) * weight)
-    assert cost[0] == pytest.approx((1.0 + 10.0 * 0.04 / 0.4) * weight)
-    assert cost[0] > cost[1]
+    assert cost[0] == pytest.approx((1.0 + 10.0 * 0.02 / 0.4) * weight)
+    assert cost[0] > cost[1]  # 10 x the depth alone: 0.5 x weight, below the pass
 
 
 def test_outside_every_clearance_the_cap_changes_nothing() -> None:
