@@ -47,3 +47,16 @@ def test_bench_refuses_an_unknown_planner(tmp_path):
     done = zenav("bench", "nav", "--planners", "nope", "--out", str(tmp_path))
     assert done.returncode == 2
     assert "unknown planner nope" in done.stderr
+
+
+def test_bench_perf_floor_section(tmp_path):
+    done = zenav("bench", "perf", "--sections", "floor", "--floor-seconds", "2",
+                 "--out", str(tmp_path), timeout=120)
+    assert done.returncode == 0, done.stderr
+    report = (tmp_path / "perf.md").read_text()
+    chain = next(line for line in report.splitlines() if "the scan's four hops" in line)
+    assert "20 scans |" in chain  # 2 s at 10 Hz, every one through the four relays
+    median = float(chain.split("|")[2].split()[0])
+    assert 0.0 < median < 100.0
+    ring = next(line for line in report.splitlines() if "the lockstep tick's six hops" in line)
+    assert int(ring.split(",")[2].split()[0]) > 0  # ticks counted round the ring

@@ -1,10 +1,10 @@
 """``zenav bench perf``: compute per scan, latency over Zenoh, lockstep speed, the
 in-process engine's speed, sustained scan rate and memory of the service stack.
 
-Six measurements (one module each: :mod:`.compute`, :mod:`.latency`, :mod:`.memory`,
-:mod:`.lockstep`, :mod:`.rate`), each printed as a Markdown table with the issue's target beside the
-measured figure (targets are reported, never asserted), and at the end one summary table
-of every target measured in this run:
+Seven measurements (one module each: :mod:`.compute`, :mod:`.latency`, :mod:`.memory`,
+:mod:`.lockstep`, :mod:`.rate`, :mod:`.floor`), each printed as a Markdown table with the
+issue's target beside the measured figure (targets are reported, never asserted), and at
+the end one summary table of every target measured in this run:
 
 - **compute**: the pure cores timed in one process on simulated 361-beam scans with 0,
   5 and 20 obstacles in view, the robot standing, one box on its path and half the
@@ -23,7 +23,10 @@ of every target measured in this run:
 - **rate**: the real-time simulator with the laser rate raised; the highest rate at which
   no service drops an input (the ``status/<service>`` counters) and every scan gets its
   base command;
-- **memory**: resident set size of each service process (psutil), during the latency run.
+- **memory**: resident set size of each service process (psutil), during the latency run;
+- **floor**: the hops alone (:mod:`.floor`): relays on the stack's mesh that forward the
+  bytes with no work, along the latency section's path and around the lockstep tick: the
+  part of those two sections' figures that no service code can remove on this machine.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from zenav.bench.compute import (
     compute_table,
     time_compute,
 )
+from zenav.bench.floor import FloorError, floor_table, measure_chain, measure_ring
 from zenav.bench.latency import (
     TARGET_LATENCY_MEDIAN_MS,
     TARGET_LATENCY_P99_MS,
@@ -66,7 +70,7 @@ from zenav.bench.memory import memory_table
 from zenav.bench.rate import highest_rate, measure_rate, rate_table
 from zenav.sim.scenario import MAX_TICKS
 
-SECTIONS = ("compute", "latency", "lockstep", "engine", "rate")
+SECTIONS = ("compute", "latency", "lockstep", "engine", "rate", "floor")
 
 
 def summary_table(figures: dict[str, tuple[str, str, bool]]) -> str:
@@ -79,7 +83,8 @@ def summary_table(figures: dict[str, tuple[str, str, bool]]) -> str:
 def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
              obstacle_counts: tuple[int, ...] = (0, 5, 20), latency_seconds: float = 30.0,
              rates: tuple[float, ...] = (10, 50, 100, 200, 300, 400, 600),
-             rate_seconds: float = 6.0, echo: Callable[[str], None] = print) -> str:
+             rate_seconds: float = 6.0, floor_seconds: float = 20.0,
+             echo: Callable[[str], None] = print) -> str:
     """Run the chosen sections; print and return the report (Markdown)."""
     parts = [f"# zenav bench perf\n\n{datetime.now().astimezone():%Y-%m-%d %H:%M %Z}, "
              f"{machine()}, Python {sys.version.split()[0]}\n"]
@@ -144,6 +149,13 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
                     rows.append(measure_rate(rate, rate_seconds, work))
                 text = (f"## Sustained scan rate in real time (h-mixed, {rate_seconds:g} s "
                         f"per rate)\n\n{rate_table(rows)}")
+            elif section == "floor":
+                chain = measure_chain(floor_seconds)
+                ring = measure_ring(floor_seconds / 2)
+                text = (f"## The hops alone: relays that forward with no work ({floor_seconds:g} s "
+                        f"of the chain, {floor_seconds / 2:g} s of the ring)\n\n"
+                        + floor_table(chain, ring, TARGET_LATENCY_MEDIAN_MS,
+                                      TARGET_LOCKSTEP_FACTOR))
             else:
                 raise ValueError(f"unknown section {section!r}; choose from {', '.join(SECTIONS)}")
             parts.append(text)
@@ -176,19 +188,25 @@ def _command(args: argparse.Namespace) -> int:
               f"{top:.0f} Hz, so that a run of {args.rate_seconds:g} s measured (--rate-seconds) "
               f"fits the simulator's {MAX_TICKS} ticks", file=sys.stderr)
         return 2
-    run_perf(sections, args.out, scans=args.scans,
-             obstacle_counts=args.obstacles, latency_seconds=args.latency_seconds,
-             rates=args.rates, rate_seconds=args.rate_seconds)
+    try:
+        run_perf(sections, args.out, scans=args.scans,
+                 obstacle_counts=args.obstacles, latency_seconds=args.latency_seconds,
+                 rates=args.rates, rate_seconds=args.rate_seconds,
+                 floor_seconds=args.floor_seconds)
+    except FloorError as exc:
+        print(f"zenav bench perf: floor: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 
 def add_command(kinds: Any) -> None:
     """``zenav bench perf`` (``kinds``: the subcommands of ``zenav bench``)."""
     perf = kinds.add_parser("perf", help="compute per scan, latency, lockstep speed, "
-                            "sustained rate, memory")
-    perf.add_argument("--sections", default="compute,latency,lockstep,engine,rate",
+                            "sustained rate, memory, the hops alone")
+    perf.add_argument("--sections", default=",".join(SECTIONS),
                       help="comma-separated: compute, latency (and memory), lockstep, "
-                      "engine (the in-process engine's speed), rate (default all)")
+                      "engine (the in-process engine's speed), rate, floor (the hops "
+                      "with no work in them) (default all)")
     perf.add_argument("--scans", type=argtypes.positive_int, default=200,
                       help="scans timed per world (compute; default 200)")
     perf.add_argument("--obstacles", type=argtypes.ints(argtypes.non_negative_int),
@@ -202,6 +220,9 @@ def add_command(kinds: Any) -> None:
                       "10,50,100,200,300,400,600)")
     perf.add_argument("--rate-seconds", type=argtypes.positive_float, default=6.0,
                       help="wall seconds measured per rate (rate; default 6)")
+    perf.add_argument("--floor-seconds", type=argtypes.positive_float, default=20.0,
+                      help="wall seconds measured along the scan's path, half that "
+                      "around the lockstep tick (floor; default 20)")
     perf.add_argument("--out", type=argtypes.path,
                       help="directory for perf.md and the runs (default: "
                       "a temporary one; the report is printed either way)")
