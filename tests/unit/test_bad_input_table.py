@@ -179,7 +179,7 @@ BAD_INPUT: list[tuple[str, Args, int, str]] = [
     ("bench perf with no sections",
      lambda t: ["bench", "perf", "--sections", "", "--out", str(t / "o")], 2,
      "zenav bench perf: --sections is empty; choose from compute, latency, lockstep, engine, "
-     "rate"),
+     "rate, floor"),
     ("bench perf --rates beyond what the simulator's tick limit lets it measure",
      lambda t: ["bench", "perf", "--sections", "rate", "--rates", "10,20000",
                 "--out", str(t / "o")], 2,
