@@ -58,5 +58,7 @@ def test_bench_perf_floor_section(tmp_path):
     assert "20 scans |" in chain  # 2 s at 10 Hz, every one through the four relays
     median = float(chain.split("|")[2].split()[0])
     assert 0.0 < median < 100.0
+    direct = next(line for line in report.splitlines() if "Zenoh's callback" in line)
+    assert "10 scans |" in direct  # 1 s at 10 Hz without the loop
     ring = next(line for line in report.splitlines() if "the lockstep tick's six hops" in line)
     assert int(ring.split(",")[2].split()[0]) > 0  # ticks counted round the ring

@@ -37,14 +37,16 @@ def test_a_ring_of_ticks_in_real_time_at_ten_hertz():
 
 
 def test_the_table_says_what_each_target_leaves_for_the_services():
-    text = floor_table([1.0, 1.5, 2.0], RingResult(1000, 4.0), 2.0, 50.0)
+    text = floor_table([1.0, 1.5, 2.0], [0.7], RingResult(1000, 4.0), 2.0, 50.0)
     assert "| 1.50 ms median |" in text
+    assert "| 0.70 ms median |" in text
+    assert "The asyncio loop's hand-off, as the services take their inputs: 0.20 ms a hop." in text
     assert "4.00 ms a tick: 25.0× real time at 10 Hz" in text
     assert "within the latency target: 0.50 ms of 2 ms (median)" in text
     # 50x is 2 ms a tick at 10 Hz, already spent twice over by the hops alone
     assert "at 50×, 2.00 ms a tick: nothing, the hops alone take more." in text
-    assert "at 20×, 5.00 ms a tick: 1.00 ms." in floor_table([1.0], RingResult(1000, 4.0),
-                                                            2.0, 20.0)
+    assert "at 20×, 5.00 ms a tick: 1.00 ms." in floor_table([1.0], [1.0],
+                                                            RingResult(1000, 4.0), 2.0, 20.0)
 
 
 def test_a_relay_with_a_role_not_in_its_mode_refuses_to_start(capsys):

@@ -65,6 +65,9 @@ RING: dict[str, tuple[str | None, str]] = {"simulator": ("base_cmd", "raw"),
                                            "laser_driver": ("raw", "scan"),
                                            **{k: v for k, v in CHAIN.items() if v[0]}}
 """Each process of the ring: (input topic, output topic)."""
+MODES = {"chain": CHAIN, "direct": CHAIN, "ring": RING}
+"""The layouts: ``direct`` is the chain with each relay putting from Zenoh's callback
+itself, with no asyncio loop (what the loop's hand-off costs a hop)."""
 
 
 class FloorError(RuntimeError):
@@ -146,7 +149,7 @@ async def _ticks(out: Publisher, answered: asyncio.Event, seconds: float) -> dic
 
 
 async def _serve(role: str, mode: str, base_port: int, seconds: float) -> None:
-    src, dst = (CHAIN if mode == "chain" else RING)[role]
+    src, dst = MODES[mode][role]
     bus = ZenohBus(loopback_mesh(role, base_port), asyncio.get_running_loop())
     try:
         out = bus.publisher(KEY.format(dst))
@@ -156,6 +159,10 @@ async def _serve(role: str, mode: str, base_port: int, seconds: float) -> None:
             answered = asyncio.Event()
             bus.subscribe(KEY.format(src)).consume(lambda _key, _payload: answered.set())
             print(json.dumps(await _ticks(out, answered, seconds)), flush=True)
+        elif mode == "direct":
+            bus.session.declare_subscriber(
+                KEY.format(src), lambda sample: out.put(sample.payload.to_bytes()))
+            await asyncio.sleep(seconds + LINK_TIMEOUT)  # until the bench stops it
         else:
             bus.subscribe(KEY.format(src)).consume(lambda _key, payload: out.put(payload))
             await asyncio.sleep(seconds + LINK_TIMEOUT)  # until the bench stops it
@@ -171,7 +178,7 @@ Processes = dict[str, "subprocess.Popen[str]"]
 @contextlib.contextmanager
 def _relays(mode: str, base_port: int, seconds: float) -> Iterator[Processes]:
     """The relay processes of ``mode``, stopped (then killed) on leaving."""
-    roles = CHAIN if mode == "chain" else RING
+    roles = MODES[mode]
     procs: Processes = {}
     try:
         for role in roles:
@@ -200,9 +207,10 @@ def _died(procs: Processes) -> str | None:
     return None
 
 
-def measure_chain(seconds: float) -> list[float]:
+def measure_chain(seconds: float, direct: bool = False) -> list[float]:
     """ms from the scan to the base command through the chain's four hops, one per scan
-    over ``seconds`` s at :data:`RATE_HZ`."""
+    over ``seconds`` s at :data:`RATE_HZ`; ``direct``: each relay forwards in Zenoh's
+    callback, with no asyncio loop."""
     base = free_port_block()
     scans: dict[int, float] = {}
     commands: dict[int, float] = {}
@@ -223,7 +231,7 @@ def measure_chain(seconds: float) -> list[float]:
                 session.declare_subscriber(KEY.format("scan"), stamper(scans)),
                 session.declare_subscriber(KEY.format("base_cmd"), stamper(commands))]
             try:
-                with _relays("chain", base, seconds) as procs:
+                with _relays("direct" if direct else "chain", base, seconds) as procs:
                     limit = LINK_TIMEOUT + SETTLE + 2 * seconds
                     deadline = time.monotonic() + limit
                     while True:
@@ -274,10 +282,12 @@ def _left(ms: float) -> str:
     return f"{fmt(ms, 2)} ms" if not ms < 0.0 else "nothing, the hops alone take more"
 
 
-def floor_table(chain_ms: list[float], ring: RingResult, latency_target_ms: float,
-                lockstep_target: float) -> str:
-    """The two floors beside the targets they bound."""
+def floor_table(chain_ms: list[float], direct_ms: list[float], ring: RingResult,
+                latency_target_ms: float, lockstep_target: float) -> str:
+    """The floors beside the targets they bound, and the chain without the loop."""
     med = statistics.median(chain_ms) if chain_ms else math.nan
+    direct = statistics.median(direct_ms) if direct_ms else math.nan
+    hops = len(CHAIN) - 1
     lines = [
         "| with no work in the services | measured | p99 | the target it bounds |",
         "|---|---|---|---|",
@@ -285,6 +295,9 @@ def floor_table(chain_ms: list[float], ring: RingResult, latency_target_ms: floa
         f"publish, seen one hop away), {len(chain_ms)} scans | {fmt(med, 2)} ms median | "
         f"{fmt(percentile(chain_ms, 99), 2)} ms | scan → base command, median ≤ "
         f"{latency_target_ms:g} ms |",
+        f"| the same four hops, each relay putting from Zenoh's callback (no asyncio loop), "
+        f"{len(direct_ms)} scans | {fmt(direct, 2)} ms median | "
+        f"{fmt(percentile(direct_ms, 99), 2)} ms | – |",
         f"| the lockstep tick's six hops, back to back, {ring.ticks} ticks in "
         f"{ring.wall:.1f} s | {fmt(ring.per_tick_ms, 2)} ms a tick: "
         f"{fmt(ring.real_time, 1)}× real time at {RATE_HZ:g} Hz | – | lockstep loop ≥ "
@@ -294,7 +307,9 @@ def floor_table(chain_ms: list[float], ring: RingResult, latency_target_ms: floa
         f"latency target: {_left(latency_target_ms - med)} of {latency_target_ms:g} ms "
         f"(median). Left for a lockstep tick's work (the simulator's tick and the six "
         f"services') at {lockstep_target:g}×, {fmt(1e3 / RATE_HZ / lockstep_target, 2)} ms a "
-        f"tick: {_left(1e3 / RATE_HZ / lockstep_target - ring.per_tick_ms)}.",
+        f"tick: {_left(1e3 / RATE_HZ / lockstep_target - ring.per_tick_ms)}. The asyncio "
+        f"loop's hand-off, as the services take their inputs: {fmt((med - direct) / hops, 2)} "
+        f"ms a hop.",
     ]
     return "\n".join(lines)
 
@@ -302,7 +317,7 @@ def floor_table(chain_ms: list[float], ring: RingResult, latency_target_ms: floa
 def main(argv: list[str]) -> int:
     """A relay process: ``ROLE MODE BASE_PORT SECONDS``."""
     role, mode, base_port, seconds = argv
-    if mode not in ("chain", "ring") or role not in (CHAIN if mode == "chain" else RING):
+    if role not in MODES.get(mode, {}):
         print(f"zenav.bench.floor: no role {role!r} in the {mode!r}", file=sys.stderr)
         return 2
     with contextlib.suppress(KeyboardInterrupt):

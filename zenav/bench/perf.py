@@ -151,10 +151,11 @@ def run_perf(sections: tuple[str, ...], out: Path | None, scans: int = 200,
                         f"per rate)\n\n{rate_table(rows)}")
             elif section == "floor":
                 chain = measure_chain(floor_seconds)
+                direct = measure_chain(floor_seconds / 2, direct=True)
                 ring = measure_ring(floor_seconds / 2)
                 text = (f"## The hops alone: relays that forward with no work ({floor_seconds:g} s "
-                        f"of the chain, {floor_seconds / 2:g} s of the ring)\n\n"
-                        + floor_table(chain, ring, TARGET_LATENCY_MEDIAN_MS,
+                        f"of the chain, {floor_seconds / 2:g} s of the others)\n\n"
+                        + floor_table(chain, direct, ring, TARGET_LATENCY_MEDIAN_MS,
                                       TARGET_LOCKSTEP_FACTOR))
             else:
                 raise ValueError(f"unknown section {section!r}; choose from {', '.join(SECTIONS)}")
@@ -222,7 +223,8 @@ def add_command(kinds: Any) -> None:
                       help="wall seconds measured per rate (rate; default 6)")
     perf.add_argument("--floor-seconds", type=argtypes.positive_float, default=20.0,
                       help="wall seconds measured along the scan's path, half that "
-                      "around the lockstep tick (floor; default 20)")
+                      "along it with no asyncio loop and around the lockstep tick (floor; "
+                      "default 20)")
     perf.add_argument("--out", type=argtypes.path,
                       help="directory for perf.md and the runs (default: "
                       "a temporary one; the report is printed either way)")
