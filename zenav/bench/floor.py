@@ -14,6 +14,8 @@ is the services' own work.
   → tracking → planner → motor bridge, five processes. The bench stamps the scan and the
   base command in Zenoh's callback as the latency section does (both seen one hop away),
   so the interval holds the same four hops.
+- **direct**: the chain again, each relay putting from Zenoh's callback itself, with no
+  asyncio loop: the difference is what the loop's hand-off costs a hop.
 - **ring**: the lockstep tick, simulator → laser driver → perception → tracking →
   planner → motor bridge → simulator, six processes. The simulator's stand-in sends the
   next tick as soon as the last is answered, as the lockstep simulator does; the figure

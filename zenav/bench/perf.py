@@ -25,8 +25,10 @@ the end one summary table of every target measured in this run:
   base command;
 - **memory**: resident set size of each service process (psutil), during the latency run;
 - **floor**: the hops alone (:mod:`.floor`): relays on the stack's mesh that forward the
-  bytes with no work, along the latency section's path and around the lockstep tick: the
-  part of those two sections' figures that no service code can remove on this machine.
+  bytes with no work, along the latency section's path (taking their input through the
+  asyncio loop as the services do, then from Zenoh's callback) and around the lockstep
+  tick: the part of those two sections' figures that the services' own work does not
+  spend on this machine.
 """
 
 from __future__ import annotations
