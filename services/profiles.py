@@ -32,6 +32,7 @@ PROFILES: dict[str, dict[str, dict[str, Any]]] = {
             "gap_floor": 0.0,  # Eq. 3 as written: theta = lambda rho sin(d_alpha)
             "min_beams": 1,  # a single beam is a cluster (the paper drops nothing)
             "edge_inset": 0.0,  # S_k from the points' cells as they fall (Eq. 2, Eq. 6)
+            "motion_split_span": 0.0,  # a cluster is what Eq. 3 joins, movers and all
         },
         "tracking": {
             "method": "paper",  # the decision tree types, Eq. 15 moves

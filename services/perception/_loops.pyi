@@ -6,6 +6,14 @@ import numpy.typing as npt
 def seen_free(points: npt.NDArray[np.float64], x: float, y: float, heading: float,
               ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
               margin: float, out: npt.NDArray[np.uint8]) -> None: ...
+def free_or_hit(points: npt.NDArray[np.float64], x: float, y: float, heading: float,
+                ranges: npt.NDArray[np.float64], angle_min: float, angle_increment: float,
+                margin: float, free: npt.NDArray[np.uint8],
+                hit: npt.NDArray[np.uint8]) -> None: ...
+def moving_cuts(starts: npt.NDArray[np.int64], ends: npt.NDArray[np.int64],
+                entered: npt.NDArray[np.uint8], stayed: npt.NDArray[np.uint8],
+                points: npt.NDArray[np.float64], min_moving: int, still_span: float,
+                cuts: npt.NDArray[np.int64]) -> int: ...
 def group_points(cluster_beams: npt.NDArray[np.int64], window_beams: npt.NDArray[np.int64],
                  window_points: npt.NDArray[np.float64], n_beams: int, reach: float,
                  member: npt.NDArray[np.int64], points: npt.NDArray[np.float64],

@@ -4,7 +4,8 @@ passes over the scan, its points and runs (the window, the Eq. 3 cuts, each run'
 end points and radius, the edge codes) and the motion cue's (the free-space test, point
 by point, the grouping of a scan's points by cluster and the scores against an earlier
 scan), with the floating-point operations of the numpy code they replaced, in the same
-order (the bearing wrapped by ``_angles.pxi``). The paper's Eqs. 1, 2, 3 and 6 are
+order (the bearing wrapped by ``_angles.pxi``); and, written here first, the cut of a
+mover out of a standing obstacle's cluster (``free_or_hit``, ``moving_cuts``). The paper's Eqs. 1, 2, 3 and 6 are
 written once, in ``_equations.pxi``; the array forms here are what ``clustering.py``'s
 equation functions call. ``clustering.py`` and ``motion_cue.py`` own the meaning;
 ``_loops.pyi`` gives the types."""
@@ -38,6 +39,37 @@ cdef inline bint free_at(double px, double py, double x, double y, double headin
     return min(ranges[b - 1], ranges[b], ranges[b + 1]) > distance + margin
 
 
+def free_or_hit(const double[:, ::1] points, double x, double y, double heading,
+                const double[::1] ranges, double angle_min, double angle_increment,
+                double margin, unsigned char[::1] free, unsigned char[::1] hit):
+    """For each point, whether the beam nearest it and both neighbours reached more than
+    ``margin`` beyond it (``free``, as ``free_at``), and whether one of those three
+    ended within ``margin`` of it (``hit``: a surface was there). A point with no beam
+    toward it (outside the scan, or nan) is neither."""
+    cdef Py_ssize_t n = ranges.shape[0]
+    cdef Py_ssize_t i, b, j
+    cdef double dx, dy, distance, bearing, beam
+    for i in range(points.shape[0]):
+        free[i] = 0
+        hit[i] = 0
+        dx = points[i, 0] - x
+        dy = points[i, 1] - y
+        distance = hypot(dx, dy)
+        bearing = wrap_angle(atan2(dy, dx) - heading)
+        beam = rint((bearing - angle_min) / angle_increment)
+        if beam < 0:  # a full-circle scan started past -pi (perception's seam turn)
+            beam += rint(2.0 * M_PI / fabs(angle_increment))
+        if not (0 <= beam <= n - 1):
+            continue
+        b = <Py_ssize_t>beam
+        if 1 <= b <= n - 2:
+            free[i] = min(ranges[b - 1], ranges[b], ranges[b + 1]) > distance + margin
+        for j in range(max(b - 1, 0), min(b + 2, n)):
+            if fabs(ranges[j] - distance) <= margin:
+                hit[i] = 1
+                break
+
+
 def seen_free(const double[:, ::1] points, double x, double y, double heading,
               const double[::1] ranges, double angle_min, double angle_increment,
               double margin, unsigned char[::1] out):
@@ -48,6 +80,56 @@ def seen_free(const double[:, ::1] points, double x, double y, double heading,
     for i in range(points.shape[0]):
         out[i] = free_at(points[i, 0], points[i, 1], x, y, heading, ranges, angle_min,
                          angle_increment, margin)
+
+
+cdef bint still_side(const unsigned char[::1] stayed, const double[:, ::1] points,
+                     Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t least, double span) noexcept:
+    """Whether at least ``least`` of the points ``lo..hi - 1`` stayed, the first and
+    last of them ``span`` m or more apart."""
+    cdef Py_ssize_t j
+    cdef Py_ssize_t first = -1
+    cdef Py_ssize_t last = -1
+    cdef Py_ssize_t count = 0
+    for j in range(lo, hi):
+        if stayed[j]:
+            if first < 0:
+                first = j
+            last = j
+            count += 1
+    if count < least:
+        return False
+    return hypot(points[last, 0] - points[first, 0], points[last, 1] - points[first, 1]) >= span
+
+
+def moving_cuts(const long[::1] starts, const long[::1] ends,
+                const unsigned char[::1] entered, const unsigned char[::1] stayed,
+                const double[:, ::1] points, Py_ssize_t min_moving, double still_span,
+                long[::1] cuts):
+    """The cuts of ``clustering.moving_cuts`` (which owns their meaning), in ascending
+    order, into ``cuts``; returns how many. A point moved where it ``entered`` and did
+    not stay."""
+    cdef Py_ssize_t i, j, a, s, e
+    cdef Py_ssize_t found = 0
+    for i in range(starts.shape[0]):
+        s = starts[i]
+        e = ends[i] + 1
+        j = s
+        while j < e:
+            if not entered[j] or stayed[j]:
+                j += 1
+                continue
+            a = j
+            while j < e and entered[j] and not stayed[j]:
+                j += 1
+            if j - a < min_moving:
+                continue
+            if still_side(stayed, points, s, a, min_moving, still_span):
+                cuts[found] = a
+                found += 1
+            if still_side(stayed, points, j, e, min_moving, still_span):
+                cuts[found] = j
+                found += 1
+    return found
 
 
 def group_points(const long[:, ::1] cluster_beams, const long[::1] window_beams,

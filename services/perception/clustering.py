@@ -374,9 +374,13 @@ def cluster_scan(
 
 
 def cluster_window(
-    window: Window, angle_increment: float, pose: Pose, params: PerceptionParams
+    window: Window, angle_increment: float, pose: Pose, params: PerceptionParams,
+    cuts: IntArray | None = None,
 ) -> Clusters:
-    """:func:`cluster_scan` from the scan's window (:func:`scan_window`)."""
+    """:func:`cluster_scan` from the scan's window (:func:`scan_window`). ``cuts``:
+    window points (indices into the window's arrays) that start a cluster of their own
+    whatever Eq. 3 says (:func:`moving_cuts`); the cluster ends on either side of a cut
+    are coded EDGE_OCCLUDED, since the obstacle beyond the cut touches them."""
     cell = params.cell
     r, valid, idx = window.ranges, window.valid, window.beams
     if idx.size == 0:
@@ -392,11 +396,17 @@ def cluster_window(
     k = _loops.run_bounds(px, py, rho, params.lambda_, math.sin(abs(angle_increment)),
                           params.gap_floor, starts, ends, counts)
     starts, ends, counts = starts[:k], ends[:k], counts[:k]
+    cut_start = cut_end = None
+    if cuts is not None and cuts.size:
+        starts, ends, cut_start, cut_end = _split_runs(starts, ends, cuts)
+        counts = ends - starts + 1
 
     if params.min_beams > 1:
         keep = counts >= params.min_beams
         if not keep.all():
             starts, ends, counts = starts[keep], ends[keep], counts[keep]
+            if cut_start is not None and cut_end is not None:
+                cut_start, cut_end = cut_start[keep], cut_end[keep]
             if starts.size == 0:
                 return Clusters.empty(pose, cell)
             # Gather the kept runs back to back so that reduceat works on them.
@@ -432,6 +442,9 @@ def cluster_window(
     beams[:, 0] = idx[starts]
     beams[:, 1] = idx[ends]
     codes = _edge_codes(r, valid, beams, angle_increment, params)
+    if cut_start is not None and cut_end is not None:
+        codes[cut_start, 0] = EDGE_OCCLUDED
+        codes[cut_end, 1] = EDGE_OCCLUDED
 
     return Clusters(
         centre=centre,
@@ -450,6 +463,53 @@ def cluster_window(
         pose=(float(x_r), float(y_r), float(th_r)),
         cell=cell,
     )
+
+
+def _split_runs(starts: IntArray, ends: IntArray, cuts: IntArray
+                ) -> tuple[IntArray, IntArray, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+    """The runs ``starts``..``ends`` (window indices, inclusive) cut before each of
+    ``cuts`` that falls inside one: the new starts and ends, and which runs start at a
+    cut and which end just before one."""
+    inside = np.asarray(cuts, dtype=np.int64)
+    run = np.searchsorted(starts, inside, side="right") - 1
+    inside = inside[(run >= 0) & (inside > starts[np.maximum(run, 0)])
+                    & (inside <= ends[np.maximum(run, 0)])]
+    new_starts = np.union1d(starts, inside)
+    owner = np.searchsorted(starts, new_starts, side="right") - 1
+    new_ends = ends[owner].copy()
+    new_ends[:-1] = np.minimum(new_ends[:-1], new_starts[1:] - 1)
+    cut_start = np.isin(new_starts, inside)
+    cut_end = np.isin(new_ends + 1, inside)
+    return new_starts, new_ends, cut_start, cut_end
+
+
+def moving_cuts(starts: IntArray, ends: IntArray, entered: npt.NDArray[np.bool_],
+                stayed: npt.NDArray[np.bool_], points: FloatArray, min_moving: int,
+                still_span: float) -> IntArray:
+    """Where a cluster holds a mover pressed against something that stands: the window
+    points (indices) at which to cut it.
+
+    Beyond the paper. A walker that passes a door's jamb or a wall closer than Eq. 3's
+    threshold joins the standing obstacle's cluster: the wall's track covers its
+    returns, and its own track goes on as a prediction only. The scans before tell the
+    two apart: the walker's points lie where an earlier
+    scan saw free space (``entered``, the motion cue's test) and the wall's where the
+    oldest scan compared with had a surface (``stayed``). Each cluster (window points
+    ``starts[i]..ends[i]``) is cut on either side of every run of at least
+    ``min_moving`` consecutive points that entered and did not stay, where that side
+    holds at least ``min_moving`` points that stayed, spread over ``still_span`` m or
+    more: a walker's own trailing points can have stayed, but never over more than its
+    width."""
+    # One compiled pass over the clusters' points (``_loops.moving_cuts``); a point
+    # starts at most one cut, so the points' count bounds the cuts.
+    cuts = np.empty(entered.shape[0], dtype=np.int64)
+    found = _loops.moving_cuts(np.ascontiguousarray(starts, dtype=np.int64),
+                               np.ascontiguousarray(ends, dtype=np.int64),
+                               np.ascontiguousarray(entered).view(np.uint8),
+                               np.ascontiguousarray(stayed).view(np.uint8),
+                               np.ascontiguousarray(points, dtype=np.float64), min_moving,
+                               still_span, cuts)
+    return cuts[:found]
 
 
 def _run_selector(starts: IntArray, counts: IntArray) -> IntArray:

@@ -158,20 +158,9 @@ class MotionCue:
         if window is None:
             window = scan_window(scan.ranges, scan.angle_min, scan.angle_increment, range_min,
                                  scan.range_max, scan.pose, self.window_radius)
+        scores, stamps = self.scores(scan, cluster_beams, window)
         # The window's global points, once per scan, kept for the scans after it.
-        beams, points = window.beams, window.points
-        scores = np.zeros((len(cluster_beams), len(self.baselines)))
-        stamps = np.full(len(self.baselines), np.nan)
-        # The clusters' points and boxes once, for every baseline.
-        clustered = cluster_points(scan, cluster_beams, beams, self.reach, points)
-        for j, baseline in enumerate(self.baselines):
-            past = self._at_least(scan.stamp - baseline)
-            if past is not None:
-                stamps[j] = past[0].stamp
-                if clustered is not None:
-                    scores[:, j] = scores_against(clustered, scan, past[0], past[2],
-                                                  self.margin)
-        self._scans.append((scan, beams, points))
+        self._scans.append((scan, window.beams, window.points))
         self._stamps.append(scan.stamp)
         oldest = scan.stamp - self.baselines[-1] - 1.0
         drop = 0
@@ -180,6 +169,45 @@ class MotionCue:
         if drop:
             del self._scans[:drop], self._stamps[:drop]
         return scores, stamps
+
+    def scores(self, scan: ScanSnapshot, cluster_beams: IntArray, window: Window
+               ) -> tuple[FloatArray, FloatArray]:
+        """:meth:`score_each`'s scores and stamps, the scan not remembered: for clusters
+        of a scan remembered already (perception's, once it has cut one), the baselines'
+        scans are the same, all older than it."""
+        scores = np.zeros((len(cluster_beams), len(self.baselines)))
+        stamps = np.full(len(self.baselines), np.nan)
+        # The clusters' points and boxes once, for every baseline.
+        clustered = cluster_points(scan, cluster_beams, window.beams, self.reach,
+                                   window.points)
+        for j, baseline in enumerate(self.baselines):
+            past = self._at_least(scan.stamp - baseline)
+            if past is not None:
+                stamps[j] = past[0].stamp
+                if clustered is not None:
+                    scores[:, j] = scores_against(clustered, scan, past[0], past[2],
+                                                  self.margin)
+        return scores, stamps
+
+    def point_motion(self, stamp: float, points: FloatArray
+                     ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]] | None:
+        """For each global point (k, 2) of the scan stamped ``stamp`` (remembered
+        already or not), against the scan of the longest baseline: whether that scan saw it
+        as free space (*entered*, the test of :func:`seen_free`), and whether it had a
+        surface within ``margin`` of it (*stayed*: something stood there that long
+        ago). One compiled pass (``_loops.free_or_hit``). None until a scan that old
+        is remembered."""
+        oldest = self._at_least(stamp - self.baselines[-1])
+        if oldest is None:
+            return None
+        scan = oldest[0]
+        points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        entered = np.empty(points.shape[0], dtype=np.bool_)
+        stayed = np.empty(points.shape[0], dtype=np.bool_)
+        _loops.free_or_hit(points, *scan.pose, scan.ranges, scan.angle_min,
+                           scan.angle_increment, self.margin, entered.view(np.uint8),
+                           stayed.view(np.uint8))
+        return entered, stayed
 
     def _at_least(self, stamp: float) -> tuple[ScanSnapshot, IntArray, FloatArray] | None:
         """The newest remembered scan taken at or before ``stamp`` (scans come in the

@@ -82,6 +82,17 @@ class PerceptionParams(BaseModel):
         "the 'vacated' half of the motion test.",
     )
 
+    motion_split_span: float = Field(
+        0.5,
+        ge=0.0,
+        description="metres: beyond the paper, a cluster that holds a mover pressed against "
+        "a standing obstacle (a walker beside a door's jamb, closer than Eq. 3's threshold) "
+        "is cut round the mover's points, those that entered space an earlier scan saw "
+        "free, where the rest holds points that stood there motion_baselines' longest ago "
+        "spread over at least this much (more than a walker is wide). 0: no cut, the "
+        "paper's clustering.",
+    )
+
     @model_validator(mode="after")
     def _window_holds_a_cell(self) -> PerceptionParams:
         if self.window_radius < self.cell:
@@ -90,5 +101,6 @@ class PerceptionParams(BaseModel):
 
     @classmethod
     def paper(cls) -> PerceptionParams:
-        """The paper's clustering exactly: Eq. 3 with no floor, single-beam clusters kept."""
-        return cls(gap_floor=0.0, min_beams=1, edge_inset=0.0)
+        """The paper's clustering exactly: Eq. 3 with no floor, single-beam clusters kept,
+        no cluster cut."""
+        return cls(gap_floor=0.0, min_beams=1, edge_inset=0.0, motion_split_span=0.0)

@@ -2,17 +2,24 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from zenav.schemas.messages import LaserScan
 from zenav.services.perception.clustering import (
     Clusters,
     Pose,
     cluster_window,
+    moving_cuts,
     rotate_scan,
     scan_window,
     seam_shift,
 )
 from zenav.services.perception.motion_cue import MotionCue, ScanSnapshot
 from zenav.services.perception.params import PerceptionParams
+
+SPLIT_MIN_BEAMS = 3
+"""Beams in a row that entered free space before a cluster is cut round them
+(``moving_cuts``): 7 cm at 4 m with the paper's 0.5 degree beams."""
 
 
 class Perceiver:
@@ -43,4 +50,20 @@ class Perceiver:
         snapshot = ScanSnapshot(scan.stamp, pose, window.ranges, angle_min, step,
                                 scan.range_max)
         each, stamps = self.cue.score_each(snapshot, scan.range_min, clusters.beams, window)
+        span = p.motion_split_span
+        if span > 0.0 and each.shape[1]:
+            # A mover pressed against a wall or a jamb gets a cluster of its own
+            # (moving_cuts). Only a cluster wider than a walker, with points in space the
+            # longest baseline's scan saw free, can hold one; the points are tested one by
+            # one only then, and the cut clusters scored again.
+            held = (clusters.radius >= 0.5 * span) & (each[:, -1] * clusters.n_beams
+                                                      >= SPLIT_MIN_BEAMS)
+            motion = self.cue.point_motion(scan.stamp, window.points) if held.any() else None
+            if motion is not None:
+                cuts = moving_cuts(np.searchsorted(window.beams, clusters.beams[:, 0]),
+                                   np.searchsorted(window.beams, clusters.beams[:, 1]),
+                                   *motion, window.points, SPLIT_MIN_BEAMS, span)
+                if cuts.size:
+                    clusters = cluster_window(window, step, pose, p, cuts)
+                    each, stamps = self.cue.scores(snapshot, clusters.beams, window)
         return clusters.with_motion(each, stamps)

@@ -35,7 +35,8 @@ def test_every_override_is_a_valid_parameter(name: str) -> None:
 
 def test_the_paper_profile_is_the_papers_rules() -> None:
     assert profile_values("paper", "perception") == {"gap_floor": 0.0, "min_beams": 1,
-                                                     "edge_inset": 0.0}
+                                                     "edge_inset": 0.0,
+                                                     "motion_split_span": 0.0}
     tracking = profile_values("paper", "tracking")
     assert tracking["method"] == "paper" and tracking["compare_dt"] > 0.1
     planner = profile_values("paper", "planner")
@@ -48,7 +49,7 @@ def test_apply_profile_keeps_the_scenarios_values_and_spares_baselines() -> None
                                          "planner": {"goal": [1, 2]}}
     apply_profile(params, "paper", "vfh")
     assert params["perception"] == {"cell": 0.25, "gap_floor": 0.3, "min_beams": 1,
-                                    "edge_inset": 0.0}
+                                    "edge_inset": 0.0, "motion_split_span": 0.0}
     assert params["planner"] == {"goal": [1, 2]}  # a baseline has none of these knobs
     assert params["tracking"]["method"] == "paper"
 
