@@ -40,6 +40,7 @@ from zenav.services.planner._loops import box_gaps, c_hypot
 from zenav.services.planner.costmap import Costmap, ScanData
 from zenav.services.planner.field import distance_field
 from zenav.services.planner.follow import (
+    arc_points,
     backing_toward,
     command_toward,
     off_discs,
@@ -102,6 +103,10 @@ NO_ROOM = "no room at the goal for the robot and its stop zone"
 
 LAST_STRETCH = "the last stretch, judged on the scan"
 """The reason of the straight path to a goal whose cell the map holds (``last_stretch``)."""
+
+BACKING_LOOK = 0.5
+"""s: how far ahead backing to a spot aside is checked against the map
+(``Planner._backs_into_map``): a cycle and the stop from the top reverse speed."""
 
 NO_ROOM_LOOK = 1.0
 """m beyond the goal's tolerance: no room at the goal starts the recovery steps, one
@@ -619,20 +624,32 @@ class Planner:
         return path_points(robot, offset / max(distance, 1e-9), distance,
                            self.p.map_resolution / 2)
 
-    def _crosses_map(self, points: Vec) -> bool:
-        """Beyond the paper: whether the robot's disc, centred on each of ``points`` (its
-        position first), would cover an occupied cell's centre of the map, deeper than
-        it does where it stands. A Morphin candidate is checked on the obstacles' cell
-        boxes S_k, and a box round an L-shaped wall, or one the robot stands inside,
-        lets a candidate through the wall itself: at a corridor's turn the sub-target
-        fell behind the inner wall, though the global path went round it."""
+    def _crosses_map(self, points: Vec, spare: float = 0.0) -> bool:
+        """Beyond the paper: whether the robot's disc, grown by ``spare`` m, centred on
+        each of ``points`` (its position first), would cover an occupied cell's centre
+        of the map, deeper than it does where it stands. A Morphin candidate is checked
+        on the obstacles' cell boxes S_k, and a box round an L-shaped wall, or one the
+        robot stands inside, lets a candidate through the wall itself: at a corridor's
+        turn the sub-target fell behind the inner wall, though the global path went
+        round it."""
         assert self.costmap is not None
         cells = self.costmap.cell_of(points)
         inside = self.costmap.inside(cells)
         gap = np.full(len(points), math.inf)
         gap[inside] = self.costmap.gap()[cells[inside, 0], cells[inside, 1]]
-        need = min(self.p.robot_radius, float(gap[0])) - 1e-6
+        need = min(self.p.robot_radius + spare, float(gap[0])) - 1e-6
         return bool((gap < need).any())
+
+    def _backs_into_map(self, pose: tuple[float, float, float], v: float,
+                        omega: float) -> bool:
+        """Whether backing at ``v`` (< 0) m/s, turning ``omega`` rad/s, for ``BACKING_LOOK``
+        s would take the robot's disc deeper into what the map holds than it is, with a
+        map cell to spare: behind the robot there is no laser and no stop zone to catch
+        what the map's cells round off (a wall's corner, up to a cell)."""
+        arc = arc_points(pose[0], pose[1], pose[2], v, omega, BACKING_LOOK,
+                         self.p.map_resolution / max(abs(v), 1e-9) / 2)
+        return self._crosses_map(np.vstack([np.asarray(pose[:2]), arc]),
+                                 self.p.map_resolution)
 
     def _disc_clear(self, points: Vec) -> bool:
         """Whether the robot's disc, centred on each of ``points``, covers no occupied
@@ -1533,6 +1550,8 @@ class Planner:
                 target, speed = hold.position, 0.0
             drive = command_toward
         v, omega = drive(pose[0], pose[1], pose[2], target, speed, p.heading_gain, p.max_omega)
+        if v < 0.0 and self._backs_into_map(pose, v, omega):
+            v = 0.0  # nothing behind the robot would stop it: stand, turning as asked
         letter: ScenarioLetter = "g" if hold.overtaking else "f"
         return Decision(v, omega, target, letter, "give_way", hold.mover, "dynamic", speed)
 

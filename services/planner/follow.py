@@ -60,6 +60,20 @@ def backing_toward(
     return -v, omega
 
 
+def arc_points(x: float, y: float, heading: float, v: float, omega: float,
+               duration: float, step: float) -> npt.NDArray[np.float64]:
+    """(k, 2) where the robot's centre is when it drives ``v`` m/s and turns ``omega``
+    rad/s from (``x``, ``y``, ``heading``), every ``step`` s up to ``duration`` s (the
+    first ``step`` s on): a circular arc, or a straight line with no turn."""
+    t = step * np.arange(1, max(round(duration / step), 1) + 1, dtype=np.float64)
+    if abs(omega) < 1e-9:
+        return np.column_stack([x + v * t * math.cos(heading), y + v * t * math.sin(heading)])
+    turned = heading + omega * t
+    r = v / omega
+    return np.column_stack([x + r * (np.sin(turned) - math.sin(heading)),
+                            y - r * (np.cos(turned) - math.cos(heading))])
+
+
 def reach_along(start: tuple[float, float], end: tuple[float, float],
                 points: npt.NDArray[np.float64], clearance: float) -> float:
     """How far (m) a disc centre can go from ``start`` straight toward ``end``, at most

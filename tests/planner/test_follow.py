@@ -9,7 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from zenav.services.planner.follow import backing_toward, command_toward, reach_along, room_near
+from zenav.services.planner.follow import (
+    arc_points,
+    backing_toward,
+    command_toward,
+    reach_along,
+    room_near,
+)
 
 
 def test_straight_ahead_far_off_drives_at_the_speed_asked_without_turning() -> None:
@@ -50,6 +56,19 @@ def test_on_the_target_there_is_nothing_to_do() -> None:
 def test_backing_turns_the_rear_toward_the_target_and_drives_it_backwards() -> None:
     v, omega = backing_toward(0.0, 0.0, 0.0, (-2.0, 0.0), 0.1, 2.0, 1.0)
     assert (v, omega) == (-0.1, 0.0)
+
+
+def test_arc_points_back_in_a_straight_line_without_a_turn() -> None:
+    points = arc_points(1.0, 2.0, 0.0, -0.4, 0.0, 0.5, 0.1)
+    assert points.shape == (5, 2)
+    assert np.allclose(points[:, 1], 2.0) and np.allclose(points[-1], (0.8, 2.0))
+
+
+def test_arc_points_follow_the_circle_of_the_turn() -> None:
+    # 0.5 m/s turning 1 rad/s: a circle of 0.5 m about (0, 0.5); a quarter of it in pi/2 s.
+    points = arc_points(0.0, 0.0, 0.0, 0.5, 1.0, math.pi / 2, math.pi / 20)
+    assert np.allclose(np.hypot(points[:, 0], points[:, 1] - 0.5), 0.5)
+    assert np.allclose(points[-1], (0.5, 0.5))
 
 
 def test_the_speed_falls_to_the_distance_covered_in_the_time_given() -> None:

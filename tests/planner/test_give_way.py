@@ -328,3 +328,15 @@ def test_spot_aside_across_the_line_and_behind_is_timed_at_the_reverse_limit() -
     own = give_way.spot_aside(robot, mover, way, 0.2, 0.45, -1, corridor(0.6), always,
                               1.0, 0.05, 0.2, 1.5, backing=(-math.pi / 2, 0.1))
     assert own == pytest.approx([0.0, 0.45], abs=1e-9)
+
+
+def test_backing_is_checked_against_the_map_behind_the_robot() -> None:
+    """Backing to a spot aside there is no laser and no stop zone behind the robot: a
+    wall the map holds 0.35 m behind its centre stops the backing that would come within
+    a cell more than the radius of it; backing away from it, or with room, goes on."""
+    end_wall = [*WALLS, (3.9, 2.1, 4.1, 3.9)]  # the corridor closed at x = 4
+    p = corridor_planner()
+    map_walls(p, (5.0, 3.0, math.pi), 2.0, boxes=end_wall, fov_deg=360.0)
+    assert p._backs_into_map((4.45, 3.0, 0.0), -0.4, 0.0)  # rear toward the wall
+    assert not p._backs_into_map((4.45, 3.0, math.pi), -0.4, 0.0)  # rear away from it
+    assert not p._backs_into_map((5.5, 3.0, 0.0), -0.4, 0.0)  # 1.4 m of room behind
