@@ -5,9 +5,9 @@ end points and radius, the edge codes) and the motion cue's (the free-space test
 by point, the grouping of a scan's points by cluster and the scores against an earlier
 scan), with the floating-point operations of the numpy code they replaced, in the same
 order (the bearing wrapped by ``_angles.pxi``); and, written here first, the cut of a
-mover out of a standing obstacle's cluster (``free_or_hit``, ``moving_cuts``). The paper's Eqs. 1, 2, 3 and 6 are
-written once, in ``_equations.pxi``; the array forms here are what ``clustering.py``'s
-equation functions call. ``clustering.py`` and ``motion_cue.py`` own the meaning;
+mover out of a standing obstacle's cluster (``free_or_hit``, ``moving_cuts``). The
+paper's Eqs. 1, 2, 3 and 6 are written once, in ``_equations.pxi``; the array forms
+here are what ``clustering.py``'s equation functions call. ``clustering.py`` and ``motion_cue.py`` own the meaning;
 ``_loops.pyi`` gives the types."""
 
 import numpy as np
@@ -19,24 +19,32 @@ include "../_angles.pxi"
 include "_equations.pxi"
 
 
-cdef inline bint free_at(double px, double py, double x, double y, double heading,
-                        const double[::1] ranges, double angle_min, double angle_increment,
-                        double margin) noexcept:
-    """Whether the beam nearest the point (half to even, as ``np.rint``) and both its
-    neighbours reached more than ``margin`` beyond it (a nan point: no beam)."""
-    cdef Py_ssize_t n = ranges.shape[0]
-    cdef Py_ssize_t b
-    cdef double dx = px - x
-    cdef double dy = py - y
-    cdef double distance = hypot(dx, dy)
+cdef inline Py_ssize_t nearest_beam(double dx, double dy, double heading, Py_ssize_t n,
+                                    double angle_min, double angle_increment) noexcept:
+    """The beam of a scan of ``n`` taken at ``heading`` nearest the direction (``dx``,
+    ``dy``) (half to even, as ``np.rint``); -1 where there is none (outside the scan, or
+    a nan point)."""
     cdef double bearing = wrap_angle(atan2(dy, dx) - heading)
     cdef double beam = rint((bearing - angle_min) / angle_increment)
     if beam < 0:  # a full-circle scan started past -pi (perception's seam turn)
         beam += rint(2.0 * M_PI / fabs(angle_increment))
-    if not (1 <= beam <= n - 2):
+    if not (0 <= beam <= n - 1):
+        return -1
+    return <Py_ssize_t>beam
+
+
+cdef inline bint free_at(double px, double py, double x, double y, double heading,
+                        const double[::1] ranges, double angle_min, double angle_increment,
+                        double margin) noexcept:
+    """Whether the beam nearest the point and both its neighbours reached more than
+    ``margin`` beyond it (a nan point: no beam)."""
+    cdef Py_ssize_t n = ranges.shape[0]
+    cdef double dx = px - x
+    cdef double dy = py - y
+    cdef Py_ssize_t b = nearest_beam(dx, dy, heading, n, angle_min, angle_increment)
+    if not (1 <= b <= n - 2):
         return False
-    b = <Py_ssize_t>beam
-    return min(ranges[b - 1], ranges[b], ranges[b + 1]) > distance + margin
+    return min(ranges[b - 1], ranges[b], ranges[b + 1]) > hypot(dx, dy) + margin
 
 
 def free_or_hit(const double[:, ::1] points, double x, double y, double heading,
@@ -48,22 +56,17 @@ def free_or_hit(const double[:, ::1] points, double x, double y, double heading,
     toward it (outside the scan, or nan) is neither."""
     cdef Py_ssize_t n = ranges.shape[0]
     cdef Py_ssize_t i, b, j
-    cdef double dx, dy, distance, bearing, beam
+    cdef double dx, dy, distance
     for i in range(points.shape[0]):
-        free[i] = 0
-        hit[i] = 0
         dx = points[i, 0] - x
         dy = points[i, 1] - y
         distance = hypot(dx, dy)
-        bearing = wrap_angle(atan2(dy, dx) - heading)
-        beam = rint((bearing - angle_min) / angle_increment)
-        if beam < 0:  # a full-circle scan started past -pi (perception's seam turn)
-            beam += rint(2.0 * M_PI / fabs(angle_increment))
-        if not (0 <= beam <= n - 1):
+        b = nearest_beam(dx, dy, heading, n, angle_min, angle_increment)
+        free[i] = 1 <= b <= n - 2 and min(ranges[b - 1], ranges[b],
+                                          ranges[b + 1]) > distance + margin
+        hit[i] = 0
+        if b < 0:
             continue
-        b = <Py_ssize_t>beam
-        if 1 <= b <= n - 2:
-            free[i] = min(ranges[b - 1], ranges[b], ranges[b + 1]) > distance + margin
         for j in range(max(b - 1, 0), min(b + 2, n)):
             if fabs(ranges[j] - distance) <= margin:
                 hit[i] = 1
